@@ -1,0 +1,603 @@
+//! Case files: the human-readable TOML input, parsed at the edge into the typed [`Model`] and
+//! [`RunSettings`]. Every key is documented in `examples/*.toml`; unknown keys are errors.
+
+use std::path::Path;
+
+use nalgebra::Vector3;
+use serde::Deserialize;
+
+use crate::contact::{Contact, NormalLaw};
+use crate::error::{Error, Result};
+use crate::friction::{Coulomb, LocalSolve};
+use crate::load::{PointLoad, TimeHistory};
+use crate::modal::{ModalBasis, Point};
+use crate::model::Model;
+use crate::obstacle::{Obstacle, Plane};
+use crate::simulation::RunSettings;
+use crate::tangential::{
+    ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
+};
+
+/// A parsed, validated case.
+#[derive(Debug, Clone)]
+pub struct Case {
+    /// Title (from the file, or its stem).
+    pub title: String,
+    /// The model.
+    pub model: Model,
+    /// Numerical settings.
+    pub settings: RunSettings,
+    /// The case as read, echoed in `summary.json`.
+    pub echo: serde_json::Value,
+}
+
+impl Case {
+    /// Reads and validates a case file. Relative paths in it are relative to its folder.
+    pub fn from_file(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let mut case = Self::from_toml_str(&text, base)?;
+        if case.title.is_empty() {
+            case.title = path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+        }
+        Ok(case)
+    }
+
+    /// Parses a case from TOML text; `base` resolves relative file names.
+    pub fn from_toml_str(text: &str, base: &Path) -> Result<Self> {
+        let file: CaseFile = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
+        let echo_value: toml::Value = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
+        let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
+        let title = file.title.clone().unwrap_or_default();
+        let (model, settings) = file.build(base)?;
+        Ok(Self {
+            title,
+            model,
+            settings,
+            echo,
+        })
+    }
+
+    /// Builds a case from a model and settings made in code.
+    pub fn from_parts(title: &str, model: Model, settings: RunSettings) -> Self {
+        Self {
+            title: title.to_string(),
+            model,
+            settings,
+            echo: serde_json::Value::Null,
+        }
+    }
+}
+
+fn parse_error(text: &str, e: &toml::de::Error) -> Error {
+    let (line, column) = match e.span() {
+        Some(span) => {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            (line, column)
+        }
+        None => (0, 0),
+    };
+    Error::Parse {
+        line,
+        column,
+        message: e.message().trim().replace('\n', " "),
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CaseFile {
+    title: Option<String>,
+    time: TimeSection,
+    structure: StructureSection,
+    initial: Option<InitialSection>,
+    #[serde(default)]
+    contacts: Vec<ContactSection>,
+    #[serde(default)]
+    loads: Vec<LoadSection>,
+    #[serde(default)]
+    tangential: TangentialSection,
+    #[serde(default)]
+    output: OutputSection,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TimeSection {
+    dt: f64,
+    duration: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+enum StructureSection {
+    PointMass {
+        mass: f64,
+        #[serde(default = "default_point_name")]
+        point: String,
+        #[serde(default)]
+        position: [f64; 3],
+    },
+    Modal {
+        frequencies_hz: Option<Vec<f64>>,
+        damping_ratio: Option<DampingInput>,
+        file: Option<String>,
+        #[serde(default)]
+        points: Vec<PointInput>,
+    },
+    PinnedBeam {
+        length: f64,
+        bending_stiffness: f64,
+        mass_per_length: f64,
+        modes_per_plane: usize,
+        #[serde(default)]
+        damping_ratio: f64,
+        points: Vec<StationInput>,
+    },
+}
+
+fn default_point_name() -> String {
+    "mass".to_string()
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum DampingInput {
+    Constant(f64),
+    PerMode(Vec<f64>),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PointInput {
+    name: String,
+    #[serde(default)]
+    coords: [f64; 3],
+    rows: Vec<Vec<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StationInput {
+    name: String,
+    x: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct InitialSection {
+    point: Option<String>,
+    displacement: Option<[f64; 3]>,
+    velocity: Option<[f64; 3]>,
+    q: Option<Vec<f64>>,
+    qdot: Option<Vec<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ContactSection {
+    name: Option<String>,
+    point: String,
+    obstacle: ObstacleInput,
+    normal: NormalInput,
+    friction: FrictionInput,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+enum ObstacleInput {
+    Plane {
+        #[serde(default)]
+        origin: [f64; 3],
+        normal: [f64; 3],
+        #[serde(default)]
+        gap: f64,
+        tangent: Option<[f64; 3]>,
+    },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NormalInput {
+    stiffness: f64,
+    #[serde(default)]
+    damping: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrictionInput {
+    mu: Option<f64>,
+    mu_static: Option<f64>,
+    mu_dynamic: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LoadSection {
+    point: String,
+    force: [f64; 3],
+    #[serde(default)]
+    history: HistoryInput,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+enum HistoryInput {
+    #[default]
+    Constant,
+    Harmonic {
+        frequency_hz: f64,
+        #[serde(default)]
+        phase_deg: f64,
+    },
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TangentialSection {
+    #[serde(default)]
+    method: MethodName,
+    #[serde(default)]
+    stick_velocity: StickVelocityName,
+    penalty: Option<PenaltyInput>,
+    #[serde(default)]
+    gauss_seidel: GaussSeidelInput,
+    #[serde(default)]
+    active_set: ActiveSetInput,
+}
+
+#[derive(Debug, Default, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+enum MethodName {
+    Penalty,
+    ActiveSet,
+    #[default]
+    GaussSeidel,
+}
+
+#[derive(Debug, Default, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+enum StickVelocityName {
+    #[default]
+    HalfStep,
+    FullStep,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PenaltyInput {
+    stiffness: f64,
+    #[serde(default)]
+    damping: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GaussSeidelInput {
+    #[serde(default = "default_tolerance")]
+    tolerance: f64,
+    #[serde(default = "default_max_sweeps")]
+    max_sweeps: usize,
+    #[serde(default)]
+    local_solve: LocalSolveName,
+    #[serde(default = "yes")]
+    warm_start: bool,
+}
+
+impl Default for GaussSeidelInput {
+    fn default() -> Self {
+        let d = GaussSeidelSettings::default();
+        Self {
+            tolerance: d.tolerance,
+            max_sweeps: d.max_sweeps,
+            local_solve: LocalSolveName::Exact,
+            warm_start: d.warm_start,
+        }
+    }
+}
+
+fn default_tolerance() -> f64 {
+    GaussSeidelSettings::default().tolerance
+}
+fn default_max_sweeps() -> usize {
+    GaussSeidelSettings::default().max_sweeps
+}
+fn yes() -> bool {
+    true
+}
+
+#[derive(Debug, Default, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+enum LocalSolveName {
+    #[default]
+    Exact,
+    Radial,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ActiveSetInput {
+    #[serde(default = "default_max_iterations")]
+    max_iterations: usize,
+}
+
+impl Default for ActiveSetInput {
+    fn default() -> Self {
+        Self {
+            max_iterations: default_max_iterations(),
+        }
+    }
+}
+
+fn default_max_iterations() -> usize {
+    ActiveSetSettings::default().max_iterations
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OutputSection {
+    #[serde(default = "one")]
+    every: u64,
+}
+
+impl Default for OutputSection {
+    fn default() -> Self {
+        Self { every: 1 }
+    }
+}
+
+fn one() -> u64 {
+    1
+}
+
+fn v3(a: [f64; 3]) -> Vector3<f64> {
+    Vector3::new(a[0], a[1], a[2])
+}
+
+impl CaseFile {
+    fn build(self, base: &Path) -> Result<(Model, RunSettings)> {
+        let basis = self.structure.build(base)?;
+        basis.validate("structure")?;
+        let mut model = Model::new(basis);
+        let point = |name: &str, field: String, model: &Model| {
+            model.basis.point_index(name).ok_or_else(|| {
+                let known: Vec<&str> = model.basis.points.iter().map(|p| p.name.as_str()).collect();
+                Error::invalid(
+                    field,
+                    format!("unknown point '{name}': the structure has {known:?}"),
+                )
+            })
+        };
+        for (k, c) in self.contacts.iter().enumerate() {
+            let field = format!("contacts[{k}]");
+            let pt = point(&c.point, format!("{field}.point"), &model)?;
+            let obstacle = match c.obstacle {
+                ObstacleInput::Plane {
+                    origin,
+                    normal,
+                    gap,
+                    tangent,
+                } => Obstacle::Plane(Plane::new(
+                    v3(origin),
+                    v3(normal),
+                    gap,
+                    tangent.map(v3),
+                    &format!("{field}.obstacle"),
+                )?),
+            };
+            let normal = NormalLaw::new(
+                c.normal.stiffness,
+                c.normal.damping,
+                &format!("{field}.normal"),
+            )?;
+            let ff = format!("{field}.friction");
+            let (mu_s, mu_d) = match (c.friction.mu, c.friction.mu_static, c.friction.mu_dynamic) {
+                (Some(mu), None, None) => (mu, mu),
+                (None, Some(s), Some(d)) => (s, d),
+                (None, Some(s), None) => (s, s),
+                (None, None, Some(d)) => (d, d),
+                _ => {
+                    return Err(Error::invalid(
+                        ff,
+                        "give either mu, or mu_static and mu_dynamic",
+                    ));
+                }
+            };
+            model.contacts.push(Contact {
+                name: c.name.clone().unwrap_or_else(|| format!("contact{k}")),
+                point: pt,
+                obstacle,
+                normal,
+                friction: Coulomb::new(mu_s, mu_d, &ff)?,
+            });
+        }
+        for (k, l) in self.loads.iter().enumerate() {
+            let field = format!("loads[{k}]");
+            let pt = point(&l.point, format!("{field}.point"), &model)?;
+            let history = match l.history {
+                HistoryInput::Constant => TimeHistory::Constant,
+                HistoryInput::Harmonic {
+                    frequency_hz,
+                    phase_deg,
+                } => TimeHistory::Harmonic {
+                    frequency_hz,
+                    phase: phase_deg.to_radians(),
+                },
+            };
+            model
+                .loads
+                .push(PointLoad::new(pt, v3(l.force), history, &field)?);
+        }
+        if let Some(init) = &self.initial {
+            let p = model.basis.modes();
+            match (&init.point, &init.q, &init.qdot) {
+                (Some(name), None, None) => {
+                    let pt = point(name, "initial.point".into(), &model)?;
+                    model.set_initial_from_point(
+                        pt,
+                        v3(init.displacement.unwrap_or_default()),
+                        v3(init.velocity.unwrap_or_default()),
+                    )?;
+                }
+                (None, q, qd) if init.displacement.is_none() && init.velocity.is_none() => {
+                    model.initial.q = q.clone().unwrap_or_else(|| vec![0.0; p]);
+                    model.initial.qdot = qd.clone().unwrap_or_else(|| vec![0.0; p]);
+                }
+                _ => {
+                    return Err(Error::invalid(
+                        "initial",
+                        "give either point with displacement/velocity, or q/qdot (modal), not both",
+                    ));
+                }
+            }
+        }
+        model.validate()?;
+
+        let t = &self.tangential;
+        let method = match t.method {
+            MethodName::Penalty => {
+                let p = t.penalty.as_ref().ok_or_else(|| {
+                    Error::invalid(
+                        "tangential.penalty",
+                        "method = \"penalty\" needs [tangential.penalty] with stiffness (K_T, N/m) and damping (C_T, N·s/m)",
+                    )
+                })?;
+                TangentialMethod::Penalty(PenaltySettings {
+                    stiffness: p.stiffness,
+                    damping: p.damping,
+                })
+            }
+            MethodName::GaussSeidel => TangentialMethod::GaussSeidel(t.gauss_seidel.settings()),
+            MethodName::ActiveSet => TangentialMethod::ActiveSet(ActiveSetSettings {
+                max_iterations: t.active_set.max_iterations,
+                fallback: t.gauss_seidel.settings(),
+            }),
+        };
+        let dt = self.time.dt;
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::invalid(
+                "time.dt",
+                format!("must be a positive time step in s (got {dt})"),
+            ));
+        }
+        let duration = self.time.duration;
+        if !(duration.is_finite() && duration > 0.0) {
+            return Err(Error::invalid(
+                "time.duration",
+                format!("must be a positive duration in s (got {duration})"),
+            ));
+        }
+        let steps = (duration / dt).round();
+        if steps > 1e12 {
+            return Err(Error::invalid(
+                "time.duration",
+                format!("gives {steps:e} steps of {dt} s: more than 1e12 steps"),
+            ));
+        }
+        let settings = RunSettings {
+            dt,
+            steps: steps as u64,
+            method,
+            stick_velocity: match t.stick_velocity {
+                StickVelocityName::HalfStep => StickVelocity::HalfStep,
+                StickVelocityName::FullStep => StickVelocity::FullStep,
+            },
+            output_every: self.output.every,
+        };
+        settings.validate()?;
+        Ok((model, settings))
+    }
+}
+
+impl GaussSeidelInput {
+    fn settings(&self) -> GaussSeidelSettings {
+        GaussSeidelSettings {
+            tolerance: self.tolerance,
+            max_sweeps: self.max_sweeps,
+            local_solve: match self.local_solve {
+                LocalSolveName::Exact => LocalSolve::Exact,
+                LocalSolveName::Radial => LocalSolve::Radial,
+            },
+            warm_start: self.warm_start,
+        }
+    }
+}
+
+impl StructureSection {
+    fn build(&self, base: &Path) -> Result<ModalBasis> {
+        match self {
+            StructureSection::PointMass {
+                mass,
+                point,
+                position,
+            } => ModalBasis::point_mass(*mass, point, v3(*position)),
+            StructureSection::PinnedBeam {
+                length,
+                bending_stiffness,
+                mass_per_length,
+                modes_per_plane,
+                damping_ratio,
+                points,
+            } => ModalBasis::pinned_beam(
+                *length,
+                *bending_stiffness,
+                *mass_per_length,
+                *modes_per_plane,
+                *damping_ratio,
+                &points
+                    .iter()
+                    .map(|s| (s.name.clone(), s.x))
+                    .collect::<Vec<_>>(),
+            ),
+            StructureSection::Modal {
+                frequencies_hz,
+                damping_ratio,
+                file,
+                points,
+            } => {
+                let mut basis = match (file, frequencies_hz) {
+                    (Some(f), None) => crate::output::read_basis_npz(&base.join(f))?,
+                    (None, Some(freq)) => ModalBasis {
+                        omega: freq.iter().map(|f| f * std::f64::consts::TAU).collect(),
+                        damping_ratio: vec![0.0; freq.len()],
+                        points: Vec::new(),
+                    },
+                    _ => {
+                        return Err(Error::invalid(
+                            "structure",
+                            "a modal structure needs either frequencies_hz (inline) or file (a .npz basis), not both",
+                        ));
+                    }
+                };
+                let p = basis.modes();
+                match damping_ratio {
+                    Some(DampingInput::Constant(x)) => basis.damping_ratio = vec![*x; p],
+                    Some(DampingInput::PerMode(v)) => basis.damping_ratio = v.clone(),
+                    None => {}
+                }
+                for (j, pt) in points.iter().enumerate() {
+                    if pt.rows.len() != 3 || pt.rows.iter().any(|r| r.len() != p) {
+                        return Err(Error::invalid(
+                            format!("structure.points[{j}].rows"),
+                            format!(
+                                "must be 3 rows (x, y, z) of {p} values each, one value per mode"
+                            ),
+                        ));
+                    }
+                    basis.points.push(Point {
+                        name: pt.name.clone(),
+                        coords: v3(pt.coords),
+                        rows: pt.rows.concat(),
+                    });
+                }
+                Ok(basis)
+            }
+        }
+    }
+}

@@ -1,0 +1,66 @@
+//! Typed errors of the library. The CLI and the Python package turn them into one-line messages.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong between a case file and a finished run.
+///
+/// Input errors name the offending field (`time.dt`, `contacts[1].normal.stiffness`, …) and
+/// say how to fix it, so that a front end only has to prefix the file name.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A value is present but wrong (non-positive mass, NaN in a mode shape, unknown point…).
+    #[error("{field}: {message}")]
+    Invalid {
+        /// Dotted path of the field in the case file.
+        field: String,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+
+    /// The case file is not valid TOML or does not match the schema (unknown key, wrong type).
+    #[error("line {line}, column {column}: {message}")]
+    Parse {
+        line: usize,
+        column: usize,
+        message: String,
+    },
+
+    /// Δt is above the stability limit of central differences (THEORY §2).
+    #[error(
+        "time.dt = {dt:e} s is above the stable limit {limit:e} s of central differences \
+         (highest modal frequency plus contact penalty stiffnesses, THEORY §2): set time.dt ≤ {suggest:e}"
+    )]
+    UnstableTimeStep { dt: f64, limit: f64, suggest: f64 },
+
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// A `.npz` modal basis is missing a key or has an array of the wrong shape.
+    #[error("{path}: {message}")]
+    Npz { path: PathBuf, message: String },
+}
+
+impl Error {
+    /// Shorthand for [`Error::Invalid`].
+    pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Invalid {
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// Result alias of the library.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,118 @@
+//! The model: modal basis, contacts, loads and initial state — everything a run needs except
+//! the numerical settings.
+
+use crate::contact::Contact;
+use crate::error::{Error, Result};
+use crate::load::PointLoad;
+use crate::modal::ModalBasis;
+
+/// Initial modal state `q(0)`, `q̇(0)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialState {
+    /// Modal displacements.
+    pub q: Vec<f64>,
+    /// Modal velocities.
+    pub qdot: Vec<f64>,
+}
+
+/// A structure on its modal basis with its contacts and loads.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// Modal basis with the rows of every point used.
+    pub basis: ModalBasis,
+    /// Contacts.
+    pub contacts: Vec<Contact>,
+    /// Point loads.
+    pub loads: Vec<PointLoad>,
+    /// Initial state.
+    pub initial: InitialState,
+}
+
+impl Model {
+    /// A model at rest with no contact and no load.
+    pub fn new(basis: ModalBasis) -> Self {
+        let p = basis.modes();
+        Self {
+            basis,
+            contacts: Vec::new(),
+            loads: Vec::new(),
+            initial: InitialState {
+                q: vec![0.0; p],
+                qdot: vec![0.0; p],
+            },
+        }
+    }
+
+    /// Checks the basis and that every index and vector length is consistent.
+    pub fn validate(&self) -> Result<()> {
+        self.basis.validate("structure")?;
+        let p = self.basis.modes();
+        let np = self.basis.points.len();
+        for (k, c) in self.contacts.iter().enumerate() {
+            if c.point >= np {
+                return Err(Error::invalid(
+                    format!("contacts[{k}].point"),
+                    "refers to no point of the structure",
+                ));
+            }
+        }
+        for (k, l) in self.loads.iter().enumerate() {
+            if l.point >= np {
+                return Err(Error::invalid(
+                    format!("loads[{k}].point"),
+                    "refers to no point of the structure",
+                ));
+            }
+        }
+        for (name, v) in [
+            ("initial.q", &self.initial.q),
+            ("initial.qdot", &self.initial.qdot),
+        ] {
+            if v.len() != p {
+                return Err(Error::invalid(
+                    name,
+                    format!("must have one value per mode ({p}), got {}", v.len()),
+                ));
+            }
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(Error::invalid(name, "must be finite numbers"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Sets the initial state from a displacement and velocity of one point, with the
+    /// minimum-norm modal state that produces them (exact for a point mass).
+    pub fn set_initial_from_point(
+        &mut self,
+        point: usize,
+        displacement: nalgebra::Vector3<f64>,
+        velocity: nalgebra::Vector3<f64>,
+    ) -> Result<()> {
+        let p = self.basis.modes();
+        let rows = &self.basis.points[point].rows;
+        let phi = nalgebra::DMatrix::from_row_slice(3, p, rows);
+        let pinv = phi.clone().pseudo_inverse(1e-12).map_err(|e| {
+            Error::invalid("initial.point", format!("its rows cannot be inverted: {e}"))
+        })?;
+        let q = &pinv * nalgebra::DVector::from_column_slice(displacement.as_slice());
+        let qd = &pinv * nalgebra::DVector::from_column_slice(velocity.as_slice());
+        for (name, target, got) in [
+            ("initial.displacement", displacement, &phi * &q),
+            ("initial.velocity", velocity, &phi * &qd),
+        ] {
+            let err = (nalgebra::DVector::from_column_slice(target.as_slice()) - got).norm();
+            if err > 1e-9 * target.norm().max(1e-300) {
+                return Err(Error::invalid(
+                    name,
+                    format!(
+                        "cannot be produced by the modes at this point (residual {err:.3e}): give initial.q / initial.qdot instead"
+                    ),
+                ));
+            }
+        }
+        self.initial.q = q.iter().copied().collect();
+        self.initial.qdot = qd.iter().copied().collect();
+        Ok(())
+    }
+}

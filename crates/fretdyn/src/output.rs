@@ -1,0 +1,211 @@
+//! Files: `results.npz` (time histories, opened by `numpy.load`), `summary.json`, and modal
+//! bases as `.npz`.
+//!
+//! Results are written to a temporary name and renamed, so a failed write never leaves a
+//! truncated file under the final name.
+//!
+//! Modal basis `.npz` keys (all float64):
+//! - `frequencies_hz` (p): natural frequencies, Hz (0 for rigid-body modes);
+//! - `damping_ratio` (p), optional: modal damping ratios (default 0, or the case's value);
+//! - `rows_<name>` (3, p): mode-shape rows of point `<name>` (x, y, z translations),
+//!   mass-normalised (`Φᵀ M Φ = I`);
+//! - `coords_<name>` (3), optional: the point's reference position, m.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector3;
+use ndarray::{Array1, Array2};
+use ndarray_npy::{NpzReader, NpzWriter};
+use serde_json::json;
+
+use crate::error::{Error, Result};
+use crate::modal::{ModalBasis, Point};
+use crate::simulation::RunResults;
+
+/// Writes `results.npz` in `dir` with the arrays of [`crate::recorder::Recorder`]:
+/// `t`, `q`, `qdot`, `contact_normal_force`, `contact_tangential_force`,
+/// `contact_slip_velocity`, `contact_penetration`, `contact_status`, and `contact_names`
+/// is not stored (names are in `summary.json`, in the same order).
+pub fn write_results_npz(dir: &Path, results: &RunResults) -> Result<PathBuf> {
+    let r = &results.recorder;
+    let path = dir.join("results.npz");
+    write_atomically(&path, |file| {
+        let mut npz = NpzWriter::new(BufWriter::new(file));
+        let e = |err: ndarray_npy::WriteNpzError| std::io::Error::other(err.to_string());
+        npz.add_array("t", &r.t).map_err(e)?;
+        npz.add_array("q", &r.q).map_err(e)?;
+        npz.add_array("qdot", &r.qdot).map_err(e)?;
+        npz.add_array("contact_normal_force", &r.normal_force)
+            .map_err(e)?;
+        npz.add_array("contact_tangential_force", &r.tangential_force)
+            .map_err(e)?;
+        npz.add_array("contact_slip_velocity", &r.slip_velocity)
+            .map_err(e)?;
+        npz.add_array("contact_penetration", &r.penetration)
+            .map_err(e)?;
+        npz.add_array("contact_status", &r.status).map_err(e)?;
+        npz.finish().map_err(e)?;
+        Ok(())
+    })?;
+    Ok(path)
+}
+
+/// The JSON summary of a run: the case echoed, per-contact statistics, energy balance, solver
+/// statistics, steps, wall time and steps/s.
+pub fn summary(title: &str, case: &serde_json::Value, results: &RunResults) -> serde_json::Value {
+    let s = &results.solver;
+    json!({
+        "fretdyn_version": env!("CARGO_PKG_VERSION"),
+        "title": title,
+        "termination": results.termination,
+        "time": {
+            "dt": results.dt,
+            "stable_dt": results.stable_dt,
+            "steps": results.steps,
+            "simulated_time": results.steps as f64 * results.dt,
+            "samples": results.recorder.len(),
+        },
+        "contacts": results.contacts,
+        "energy_balance": results.energy,
+        "solver": {
+            "counters": s,
+            "gauss_seidel_sweeps_mean": s.gs_sweeps_mean(),
+            "active_set_iterations_mean": s.as_iterations_mean(),
+        },
+        "performance": {
+            "wall_time_s": results.wall_time,
+            "steps_per_second": results.steps_per_second(),
+        },
+        "case": case,
+    })
+}
+
+/// Writes `summary.json` in `dir`.
+pub fn write_summary(dir: &Path, summary: &serde_json::Value) -> Result<PathBuf> {
+    let path = dir.join("summary.json");
+    write_atomically(&path, |mut file| {
+        serde_json::to_writer_pretty(&mut file, summary).map_err(std::io::Error::other)?;
+        use std::io::Write;
+        file.write_all(b"\n")
+    })?;
+    Ok(path)
+}
+
+fn write_atomically(path: &Path, write: impl FnOnce(File) -> std::io::Result<()>) -> Result<()> {
+    let tmp = path.with_extension("partial");
+    let file = File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
+    if let Err(e) = write(file) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::io(path, e));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+}
+
+/// Reads a modal basis `.npz` (keys in the module documentation).
+pub fn read_basis_npz(path: &Path) -> Result<ModalBasis> {
+    let npz_err = |message: String| Error::Npz {
+        path: path.to_path_buf(),
+        message,
+    };
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut npz = NpzReader::new(file).map_err(|e| npz_err(format!("not a .npz file: {e}")))?;
+    let names = npz
+        .names()
+        .map_err(|e| npz_err(format!("cannot list arrays: {e}")))?;
+    let freq: Array1<f64> = npz.by_name("frequencies_hz").map_err(|e| {
+        npz_err(format!(
+            "key 'frequencies_hz' (float64, shape (p,)) missing or unreadable: {e}"
+        ))
+    })?;
+    let p = freq.len();
+    let damping_ratio = if names.iter().any(|n| n == "damping_ratio") {
+        let d: Array1<f64> = npz
+            .by_name("damping_ratio")
+            .map_err(|e| npz_err(format!("key 'damping_ratio' must be float64 (p,): {e}")))?;
+        if d.len() != p {
+            return Err(npz_err(format!(
+                "'damping_ratio' has {} values for {p} modes",
+                d.len()
+            )));
+        }
+        d.to_vec()
+    } else {
+        vec![0.0; p]
+    };
+    let mut points = Vec::new();
+    for name in names.iter().filter_map(|n| n.strip_prefix("rows_")) {
+        let rows: Array2<f64> = npz.by_name(&format!("rows_{name}")).map_err(|e| {
+            npz_err(format!(
+                "key 'rows_{name}' must be float64 of shape (3, {p}): {e}"
+            ))
+        })?;
+        if rows.shape() != [3, p] {
+            return Err(npz_err(format!(
+                "'rows_{name}' has shape {:?}, expected (3, {p}): x, y, z rows, one column per mode",
+                rows.shape()
+            )));
+        }
+        let coords = if names.iter().any(|n| *n == format!("coords_{name}")) {
+            let c: Array1<f64> = npz
+                .by_name(&format!("coords_{name}"))
+                .map_err(|e| npz_err(format!("key 'coords_{name}' must be float64 (3,): {e}")))?;
+            if c.len() != 3 {
+                return Err(npz_err(format!(
+                    "'coords_{name}' has {} values, expected 3",
+                    c.len()
+                )));
+            }
+            Vector3::new(c[0], c[1], c[2])
+        } else {
+            Vector3::zeros()
+        };
+        points.push(Point {
+            name: name.to_string(),
+            coords,
+            rows: rows.iter().copied().collect(),
+        });
+    }
+    if points.is_empty() {
+        return Err(npz_err(
+            "no point rows: add arrays 'rows_<name>' of shape (3, p)".to_string(),
+        ));
+    }
+    let basis = ModalBasis {
+        omega: freq.iter().map(|f| f * std::f64::consts::TAU).collect(),
+        damping_ratio,
+        points,
+    };
+    basis.validate(&path.display().to_string()).map(|_| basis)
+}
+
+/// Writes a modal basis as `.npz` (keys in the module documentation).
+pub fn write_basis_npz(path: &Path, basis: &ModalBasis) -> Result<()> {
+    let p = basis.modes();
+    write_atomically(path, |file| {
+        let e = |err: ndarray_npy::WriteNpzError| std::io::Error::other(err.to_string());
+        let mut npz = NpzWriter::new(BufWriter::new(file));
+        let freq: Array1<f64> = basis
+            .omega
+            .iter()
+            .map(|w| w / std::f64::consts::TAU)
+            .collect();
+        npz.add_array("frequencies_hz", &freq).map_err(e)?;
+        npz.add_array("damping_ratio", &Array1::from(basis.damping_ratio.clone()))
+            .map_err(e)?;
+        for pt in &basis.points {
+            let rows = Array2::from_shape_vec((3, p), pt.rows.clone())
+                .map_err(|err| std::io::Error::other(err.to_string()))?;
+            npz.add_array(format!("rows_{}", pt.name), &rows)
+                .map_err(e)?;
+            npz.add_array(
+                format!("coords_{}", pt.name),
+                &Array1::from(pt.coords.iter().copied().collect::<Vec<_>>()),
+            )
+            .map_err(e)?;
+        }
+        npz.finish().map_err(e)?;
+        Ok(())
+    })
+}

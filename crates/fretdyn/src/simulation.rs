@@ -1,0 +1,678 @@
+//! The time-step loop: central differences on the modes, contacts on the physical basis at the
+//! contact points only, tangential forces by the chosen method (THEORY §2, steps 1–7).
+//!
+//! Everything the loop touches is allocated before the first step.
+
+use std::ops::ControlFlow;
+use std::time::Instant;
+
+use nalgebra::{Vector2, Vector3};
+use serde::Serialize;
+
+use crate::central_difference::CentralDifference;
+use crate::delassus::{Slot, TangentialProblem};
+use crate::error::{Error, Result};
+use crate::friction::Slide;
+use crate::modal::{dot, project_add, recombine};
+use crate::model::Model;
+use crate::obstacle::ContactFrame;
+use crate::recorder::{ContactSample, Recorder};
+use crate::stability::stable_time_step;
+use crate::statistics::{ContactAccumulator, ContactStatistics, EnergyBalance};
+use crate::tangential::active_set::{ActiveSet, History};
+use crate::tangential::penalty::PenaltyContact;
+use crate::tangential::{SolverStatistics, StickVelocity, TangentialMethod, gauss_seidel};
+
+/// Numerical settings of a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunSettings {
+    /// Time step Δt, s.
+    pub dt: f64,
+    /// Number of steps.
+    pub steps: u64,
+    /// Tangential method.
+    pub method: TangentialMethod,
+    /// Velocity the stick constraint acts on (Lagrange methods).
+    pub stick_velocity: StickVelocity,
+    /// Keep every `output_every`-th step in the recorded time histories (statistics use all).
+    pub output_every: u64,
+}
+
+impl RunSettings {
+    /// Checks the numbers (not the stability limit, which needs the model).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(Error::invalid(
+                "time.dt",
+                format!("must be a positive time step in s (got {})", self.dt),
+            ));
+        }
+        if self.output_every == 0 {
+            return Err(Error::invalid(
+                "output.every",
+                "must be at least 1 (1 keeps every step)",
+            ));
+        }
+        match &self.method {
+            TangentialMethod::Penalty(p) => {
+                if !(p.stiffness.is_finite() && p.stiffness > 0.0) {
+                    return Err(Error::invalid(
+                        "tangential.penalty.stiffness",
+                        format!("must be a positive K_T in N/m (got {})", p.stiffness),
+                    ));
+                }
+                if !(p.damping.is_finite() && p.damping >= 0.0) {
+                    return Err(Error::invalid(
+                        "tangential.penalty.damping",
+                        format!("must be a C_T ≥ 0 in N·s/m (got {})", p.damping),
+                    ));
+                }
+            }
+            TangentialMethod::GaussSeidel(g) => check_gs(g, "tangential.gauss_seidel")?,
+            TangentialMethod::ActiveSet(a) => {
+                if a.max_iterations == 0 {
+                    return Err(Error::invalid(
+                        "tangential.active_set.max_iterations",
+                        "must be at least 1",
+                    ));
+                }
+                check_gs(&a.fallback, "tangential.gauss_seidel")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+fn check_gs(g: &crate::tangential::GaussSeidelSettings, field: &str) -> Result<()> {
+    if !(g.tolerance.is_finite() && g.tolerance > 0.0) {
+        return Err(Error::invalid(
+            format!("{field}.tolerance"),
+            format!(
+                "must be a positive relative tolerance, e.g. 1e-12 (got {})",
+                g.tolerance
+            ),
+        ));
+    }
+    if g.max_sweeps == 0 {
+        return Err(Error::invalid(
+            format!("{field}.max_sweeps"),
+            "must be at least 1",
+        ));
+    }
+    Ok(())
+}
+
+/// Progress report passed to the observer of [`run`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Progress {
+    /// Steps done.
+    pub step: u64,
+    /// Steps in the run.
+    pub total: u64,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum Termination {
+    /// Every step was done.
+    Completed,
+    /// The state became non-finite at `step`; results up to the previous sample are kept.
+    Diverged {
+        step: u64,
+        time: f64,
+        /// The contact whose force was non-finite first, if any.
+        contact: Option<String>,
+    },
+    /// The observer asked to stop.
+    Stopped { step: u64 },
+}
+
+/// Everything a run produces.
+#[derive(Debug, Clone)]
+pub struct RunResults {
+    /// Output time histories.
+    pub recorder: Recorder,
+    /// Per-contact statistics over every step done.
+    pub contacts: Vec<ContactStatistics>,
+    /// Tangential solver counters.
+    pub solver: SolverStatistics,
+    /// Energy balance.
+    pub energy: EnergyBalance,
+    /// Steps done.
+    pub steps: u64,
+    /// Time step, s.
+    pub dt: f64,
+    /// Stability limit of the time step, s.
+    pub stable_dt: f64,
+    /// Wall-clock time of the step loop, s.
+    pub wall_time: f64,
+    /// How the run ended.
+    pub termination: Termination,
+}
+
+impl RunResults {
+    /// Steps per second of wall time.
+    pub fn steps_per_second(&self) -> f64 {
+        if self.wall_time > 0.0 {
+            self.steps as f64 / self.wall_time
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Runs `model` with `settings` without progress reporting.
+pub fn simulate(model: &Model, settings: &RunSettings) -> Result<RunResults> {
+    run(model, settings, |_| ControlFlow::Continue(()))
+}
+
+/// Runs `model` with `settings`. `observer` is called every 1024 steps and at the end; it may
+/// stop the run by returning `ControlFlow::Break`.
+///
+/// Errors are input errors (including a Δt above the stable limit). A run that diverges or is
+/// stopped returns `Ok` with its [`Termination`] and the results written so far.
+pub fn run(
+    model: &Model,
+    settings: &RunSettings,
+    mut observer: impl FnMut(Progress) -> ControlFlow<()>,
+) -> Result<RunResults> {
+    model.validate()?;
+    settings.validate()?;
+    let stable_dt = stable_time_step(model, &settings.method);
+    if settings.dt >= stable_dt {
+        return Err(Error::UnstableTimeStep {
+            dt: settings.dt,
+            limit: stable_dt,
+            suggest: 0.9 * stable_dt,
+        });
+    }
+    let mut sim = Simulation::new(model, settings, stable_dt);
+    let start = Instant::now();
+    sim.start();
+    let total = settings.steps;
+    let mut termination = Termination::Completed;
+    for n in 0..total {
+        if let Err(contact) = sim.step() {
+            termination = Termination::Diverged {
+                step: n + 1,
+                time: (n + 1) as f64 * settings.dt,
+                contact: contact.map(|c| model.contacts[c].name.clone()),
+            };
+            break;
+        }
+        if (n + 1) % 1024 == 0
+            && n + 1 < total
+            && observer(Progress { step: n + 1, total }).is_break()
+        {
+            termination = Termination::Stopped { step: n + 1 };
+            break;
+        }
+    }
+    let wall_time = start.elapsed().as_secs_f64();
+    let _ = observer(Progress {
+        step: sim.step,
+        total,
+    });
+    Ok(sim.finish(wall_time, stable_dt, termination))
+}
+
+/// Per-contact state within a step.
+#[derive(Debug, Clone, Copy)]
+struct ContactState {
+    frame: ContactFrame,
+    /// Physical position of the point.
+    x: Vector3<f64>,
+    /// Point velocity relative to the obstacle (predicted during the step, full-step after).
+    v: Vector3<f64>,
+    normal_force: f64,
+    /// Tangential force of the obstacle on the structure, tangent basis.
+    tangential_force: Vector2<f64>,
+    closed: bool,
+    slide: Slide,
+}
+
+impl ContactState {
+    fn tangential_velocity(&self) -> Vector2<f64> {
+        Vector2::new(
+            self.frame.tangents[0].dot(&self.v),
+            self.frame.tangents[1].dot(&self.v),
+        )
+    }
+
+    fn status_code(&self) -> i8 {
+        match (self.closed, self.slide) {
+            (false, _) => 0,
+            (true, Slide::Stick) => 1,
+            (true, Slide::Slip) => 2,
+        }
+    }
+}
+
+/// Method-specific state (one per run, so the size difference of the variants is irrelevant).
+#[allow(clippy::large_enum_variant)]
+enum Tangential {
+    Penalty {
+        settings: crate::tangential::PenaltySettings,
+        contacts: Vec<PenaltyContact>,
+    },
+    Lagrange {
+        problem: TangentialProblem,
+        solver: LagrangeSolver,
+        theta_dt: f64,
+        lambda: Vec<Vector2<f64>>,
+        slide: Vec<Slide>,
+        /// Per contact: previous step's status, direction and λ (warm start).
+        history: Vec<History>,
+        previous_lambda: Vec<Vector2<f64>>,
+    },
+}
+
+enum LagrangeSolver {
+    GaussSeidel(crate::tangential::GaussSeidelSettings),
+    ActiveSet(Box<ActiveSet>),
+}
+
+struct Simulation<'m> {
+    model: &'m Model,
+    settings: &'m RunSettings,
+    cd: CentralDifference,
+    contacts: Vec<ContactState>,
+    tangential: Tangential,
+    /// Modal loads `Φ_lᵀ F_l`, one row of p per load.
+    load_rows: Vec<f64>,
+    external: Vec<f64>,
+    force: Vec<f64>,
+    accumulators: Vec<ContactAccumulator>,
+    solver_stats: SolverStatistics,
+    energy: EnergyBalance,
+    recorder: Recorder,
+    step: u64,
+}
+
+impl<'m> Simulation<'m> {
+    fn new(model: &'m Model, settings: &'m RunSettings, _stable_dt: f64) -> Self {
+        let p = model.basis.modes();
+        let nc = model.contacts.len();
+        let mut cd = CentralDifference::new(&model.basis, settings.dt);
+        cd.q.copy_from_slice(&model.initial.q);
+        cd.qd.copy_from_slice(&model.initial.qdot);
+        let mut load_rows = vec![0.0; p * model.loads.len()];
+        for (l, load) in model.loads.iter().enumerate() {
+            project_add(
+                &model.basis.points[load.point].rows,
+                &load.force,
+                &mut load_rows[l * p..(l + 1) * p],
+            );
+        }
+        let tangential = match settings.method {
+            TangentialMethod::Penalty(s) => Tangential::Penalty {
+                settings: s,
+                contacts: vec![PenaltyContact::default(); nc],
+            },
+            TangentialMethod::GaussSeidel(s) => {
+                Tangential::lagrange(p, nc, settings, LagrangeSolver::GaussSeidel(s))
+            }
+            TangentialMethod::ActiveSet(s) => Tangential::lagrange(
+                p,
+                nc,
+                settings,
+                LagrangeSolver::ActiveSet(Box::new(ActiveSet::new(s, nc))),
+            ),
+        };
+        let samples = (settings.steps / settings.output_every + 1) as usize;
+        let blank = ContactState {
+            frame: ContactFrame {
+                penetration: 0.0,
+                normal: Vector3::zeros(),
+                tangents: [Vector3::zeros(); 2],
+                velocity: Vector3::zeros(),
+            },
+            x: Vector3::zeros(),
+            v: Vector3::zeros(),
+            normal_force: 0.0,
+            tangential_force: Vector2::zeros(),
+            closed: false,
+            slide: Slide::Stick,
+        };
+        Self {
+            model,
+            settings,
+            cd,
+            contacts: vec![blank; nc],
+            tangential,
+            load_rows,
+            external: vec![0.0; p],
+            force: vec![0.0; p],
+            accumulators: vec![ContactAccumulator::default(); nc],
+            solver_stats: SolverStatistics::default(),
+            energy: EnergyBalance::default(),
+            recorder: Recorder::new(samples, p, nc),
+            step: 0,
+        }
+    }
+
+    /// t = 0: contacts at the initial state, initial acceleration, first sample.
+    fn start(&mut self) {
+        self.external_force(0.0);
+        self.detect(false);
+        self.contact_forces();
+        self.cd.start(&self.force);
+        for c in &mut self.contacts {
+            // the velocities were the initial (full-step) ones already
+            if c.closed && c.tangential_force == Vector2::zeros() {
+                c.slide = if c.tangential_velocity().norm() > 0.0 {
+                    Slide::Slip
+                } else {
+                    Slide::Stick
+                };
+            }
+        }
+        let (e, powers) = self.energy_and_powers();
+        self.energy = EnergyBalance::start(e, powers);
+        self.sample();
+    }
+
+    /// One step n → n+1. `Err(Some(c))`: contact `c` produced a non-finite force;
+    /// `Err(None)`: the modal state became non-finite.
+    fn step(&mut self) -> std::result::Result<(), Option<usize>> {
+        self.step += 1;
+        let t = self.step as f64 * self.settings.dt;
+        self.cd.predict();
+        self.external_force(t);
+        self.detect(true);
+        self.contact_forces();
+        self.cd.free_acceleration(&self.force);
+        self.lagrange();
+        self.cd.correct();
+        self.full_step_velocities(false);
+
+        let dt = self.settings.dt;
+        for (k, c) in self.contacts.iter().enumerate() {
+            if !(c.normal_force.is_finite() && c.tangential_force.iter().all(|v| v.is_finite())) {
+                return Err(Some(k));
+            }
+            let power = if c.closed {
+                c.tangential_force.dot(&c.tangential_velocity()).abs()
+            } else {
+                0.0
+            };
+            self.accumulators[k].add(
+                c.closed,
+                c.slide == Slide::Stick,
+                c.normal_force,
+                c.tangential_force.norm(),
+                power,
+                c.frame.penetration,
+                dt,
+            );
+        }
+        let (e, powers) = self.energy_and_powers();
+        if !e.is_finite() {
+            return Err(None);
+        }
+        self.energy.step(e, powers, dt);
+        if self.step % self.settings.output_every == 0 {
+            self.full_step_velocities(true);
+            self.sample();
+        }
+        Ok(())
+    }
+
+    fn external_force(&mut self, t: f64) {
+        let p = self.external.len();
+        self.external.iter_mut().for_each(|f| *f = 0.0);
+        for (l, load) in self.model.loads.iter().enumerate() {
+            let s = load.history.value(t);
+            for (f, g) in self
+                .external
+                .iter_mut()
+                .zip(&self.load_rows[l * p..(l + 1) * p])
+            {
+                *f += s * g;
+            }
+        }
+    }
+
+    /// Step 3: positions, velocities (predicted when `predicted`), frames and normal forces.
+    fn detect(&mut self, predicted: bool) {
+        let velocity = if predicted {
+            &self.cd.qd_star
+        } else {
+            &self.cd.qd
+        };
+        for (c, state) in self.model.contacts.iter().zip(&mut self.contacts) {
+            let pt = &self.model.basis.points[c.point];
+            state.x = pt.coords + recombine(&pt.rows, &self.cd.q);
+            state.frame = c.frame(&state.x);
+            state.v = recombine(&pt.rows, velocity) - state.frame.velocity;
+            let rate = -state.frame.normal.dot(&state.v);
+            state.normal_force = c.normal.force(state.frame.penetration, rate);
+            state.closed = state.frame.penetration > 0.0;
+            state.tangential_force = Vector2::zeros();
+        }
+    }
+
+    /// Step 4 (and the penalty tangential forces): modal force `f = f_ext + Σ Φ_cᵀ R_c`.
+    fn contact_forces(&mut self) {
+        self.force.copy_from_slice(&self.external);
+        for (k, (c, state)) in self
+            .model
+            .contacts
+            .iter()
+            .zip(&mut self.contacts)
+            .enumerate()
+        {
+            if let Tangential::Penalty { settings, contacts } = &mut self.tangential {
+                if state.closed {
+                    let vt = state.tangential_velocity();
+                    state.tangential_force = contacts[k].force(
+                        settings,
+                        &c.friction,
+                        &state.frame.tangents,
+                        &state.x,
+                        vt,
+                        state.normal_force,
+                    );
+                    state.slide = contacts[k].slide;
+                } else {
+                    contacts[k].open();
+                }
+            }
+            if state.closed {
+                let t = &state.frame.tangents;
+                let f = state.frame.normal * state.normal_force
+                    + t[0] * state.tangential_force.x
+                    + t[1] * state.tangential_force.y;
+                project_add(&self.model.basis.points[c.point].rows, &f, &mut self.force);
+            }
+        }
+    }
+
+    /// Step 6 for the Lagrange methods.
+    fn lagrange(&mut self) {
+        let Tangential::Lagrange {
+            problem,
+            solver,
+            theta_dt,
+            lambda,
+            slide,
+            history,
+            previous_lambda,
+        } = &mut self.tangential
+        else {
+            return;
+        };
+        problem.clear();
+        for (k, (c, state)) in self.model.contacts.iter().zip(&self.contacts).enumerate() {
+            if state.closed {
+                problem.push(
+                    Slot {
+                        contact: k,
+                        s_static: c.friction.mu_static * state.normal_force,
+                        s_dynamic: c.friction.mu_dynamic * state.normal_force,
+                    },
+                    &state.frame.tangents,
+                    &self.model.basis.points[c.point].rows,
+                    &self.cd.a_inv,
+                );
+            }
+        }
+        if problem.is_empty() {
+            history.iter_mut().for_each(|h| h.closed = false);
+            return;
+        }
+        let contacts = &self.contacts;
+        problem.assemble(&self.cd.qdd, &self.cd.qd_star, *theta_dt, |slot| {
+            let f = &contacts[slot.contact].frame;
+            Vector2::new(
+                f.tangents[0].dot(&f.velocity),
+                f.tangents[1].dot(&f.velocity),
+            )
+        });
+        let m = problem.len();
+        for (k, slot) in problem.slots().iter().enumerate() {
+            let warm = match solver {
+                LagrangeSolver::GaussSeidel(s) => s.warm_start,
+                LagrangeSolver::ActiveSet(_) => false,
+            };
+            lambda[k] = if warm && history[slot.contact].closed {
+                previous_lambda[slot.contact]
+            } else {
+                Vector2::zeros()
+            };
+        }
+        self.solver_stats.lagrange_steps += 1;
+        match solver {
+            LagrangeSolver::GaussSeidel(s) => {
+                let sweeps = gauss_seidel::solve(s, problem, &mut lambda[..m], &mut slide[..m]);
+                self.solver_stats.gs_sweeps_total += sweeps.count as u64;
+                self.solver_stats.gs_sweeps_max =
+                    self.solver_stats.gs_sweeps_max.max(sweeps.count as u64);
+                if !sweeps.converged {
+                    self.solver_stats.gs_nonconverged_steps += 1;
+                }
+            }
+            LagrangeSolver::ActiveSet(a) => {
+                a.solve(
+                    problem,
+                    history,
+                    &mut lambda[..m],
+                    &mut slide[..m],
+                    &mut self.solver_stats,
+                );
+            }
+        }
+        problem.apply(&lambda[..m], &mut self.cd.qdd);
+        history.iter_mut().for_each(|h| h.closed = false);
+        for (k, slot) in problem.slots().iter().enumerate() {
+            let state = &mut self.contacts[slot.contact];
+            state.tangential_force = -lambda[k];
+            state.slide = slide[k];
+            let n = lambda[k].norm();
+            history[slot.contact] = History {
+                closed: true,
+                slide: slide[k],
+                direction: if n > 0.0 {
+                    lambda[k] / n
+                } else {
+                    Vector2::zeros()
+                },
+            };
+            previous_lambda[slot.contact] = lambda[k];
+        }
+    }
+
+    /// Full-step velocities `Φ_c q̇_{n+1}` of the closed contacts (of all when `all`).
+    fn full_step_velocities(&mut self, all: bool) {
+        for (c, state) in self.model.contacts.iter().zip(&mut self.contacts) {
+            if state.closed || all {
+                let pt = &self.model.basis.points[c.point];
+                state.v = recombine(&pt.rows, &self.cd.qd) - state.frame.velocity;
+            }
+        }
+    }
+
+    /// Energy `E` and the powers `[external, modal damping, contact damping, tangential]`.
+    fn energy_and_powers(&self) -> (f64, [f64; 4]) {
+        let mut e = self.cd.modal_energy();
+        let mut contact_damping = 0.0;
+        let mut tangential = 0.0;
+        for (c, s) in self.model.contacts.iter().zip(&self.contacts) {
+            if s.closed {
+                let d = s.frame.penetration;
+                e += 0.5 * c.normal.stiffness * d * d;
+                let rate = -s.frame.normal.dot(&s.v);
+                contact_damping += (s.normal_force - c.normal.stiffness * d) * rate;
+                tangential -= s.tangential_force.dot(&s.tangential_velocity());
+            }
+        }
+        let external = dot(&self.external, &self.cd.qd);
+        (
+            e,
+            [
+                external,
+                self.cd.damping_power(),
+                contact_damping,
+                tangential,
+            ],
+        )
+    }
+
+    fn sample(&mut self) {
+        let t = self.step as f64 * self.settings.dt;
+        if !self.recorder.push_state(t, &self.cd.q, &self.cd.qd) {
+            return;
+        }
+        for (k, s) in self.contacts.iter().enumerate() {
+            let vt = s.tangential_velocity();
+            self.recorder.contact(
+                k,
+                &ContactSample {
+                    normal_force: s.normal_force,
+                    tangential_force: [s.tangential_force.x, s.tangential_force.y],
+                    slip_velocity: [vt.x, vt.y],
+                    penetration: s.frame.penetration,
+                    status: s.status_code(),
+                },
+            );
+        }
+    }
+
+    fn finish(mut self, wall_time: f64, stable_dt: f64, termination: Termination) -> RunResults {
+        self.recorder.truncate();
+        let dt = self.settings.dt;
+        let steps = self.step;
+        RunResults {
+            contacts: self
+                .model
+                .contacts
+                .iter()
+                .zip(&self.accumulators)
+                .map(|(c, a)| a.finish(&c.name, steps, dt))
+                .collect(),
+            recorder: self.recorder,
+            solver: self.solver_stats,
+            energy: self.energy,
+            steps,
+            dt,
+            stable_dt,
+            wall_time,
+            termination,
+        }
+    }
+}
+
+impl Tangential {
+    fn lagrange(p: usize, nc: usize, settings: &RunSettings, solver: LagrangeSolver) -> Self {
+        Tangential::Lagrange {
+            problem: TangentialProblem::new(p, nc),
+            solver,
+            theta_dt: settings.stick_velocity.theta() * settings.dt,
+            lambda: vec![Vector2::zeros(); nc],
+            slide: vec![Slide::Stick; nc],
+            history: vec![History::default(); nc],
+            previous_lambda: vec![Vector2::zeros(); nc],
+        }
+    }
+}
