@@ -10,7 +10,7 @@ use crate::contact::{Contact, NormalLaw};
 use crate::error::{Error, Result};
 use crate::friction::{Coulomb, LocalSolve};
 use crate::load::{PointLoad, TimeHistory};
-use crate::modal::{ModalBasis, Point};
+use crate::modal::{ModalBasis, PinnedBeam, Point};
 use crate::model::Model;
 use crate::obstacle::{Obstacle, Plane};
 use crate::simulation::RunSettings;
@@ -135,6 +135,10 @@ enum StructureSection {
         bending_stiffness: f64,
         mass_per_length: f64,
         modes_per_plane: usize,
+        #[serde(default)]
+        axial_stiffness: f64,
+        #[serde(default)]
+        axial_modes: usize,
         #[serde(default)]
         damping_ratio: f64,
         points: Vec<StationInput>,
@@ -542,14 +546,20 @@ impl StructureSection {
                 bending_stiffness,
                 mass_per_length,
                 modes_per_plane,
+                axial_stiffness,
+                axial_modes,
                 damping_ratio,
                 points,
             } => ModalBasis::pinned_beam(
-                *length,
-                *bending_stiffness,
-                *mass_per_length,
-                *modes_per_plane,
-                *damping_ratio,
+                &PinnedBeam {
+                    length: *length,
+                    bending_stiffness: *bending_stiffness,
+                    mass_per_length: *mass_per_length,
+                    modes_per_plane: *modes_per_plane,
+                    axial_stiffness: *axial_stiffness,
+                    axial_modes: *axial_modes,
+                    damping_ratio: *damping_ratio,
+                },
                 &points
                     .iter()
                     .map(|s| (s.name.clone(), s.x))

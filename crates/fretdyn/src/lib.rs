@@ -22,6 +22,7 @@
 // Index loops mirror the equations of THEORY.md; `!(x > y)` is deliberate: it is true for NaN.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod benchmark;
 pub mod case;
 pub mod central_difference;
 pub mod contact;

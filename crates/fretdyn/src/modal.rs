@@ -22,6 +22,25 @@ pub struct Point {
     pub rows: Vec<f64>,
 }
 
+/// Properties of an analytic pinned–pinned beam ([`ModalBasis::pinned_beam`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PinnedBeam {
+    /// Length `L`, m.
+    pub length: f64,
+    /// Bending stiffness `E I`, N·m².
+    pub bending_stiffness: f64,
+    /// Mass per unit length `ρA` (structure, inner fluid and added mass), kg/m.
+    pub mass_per_length: f64,
+    /// Bending modes in each of the planes (x, y) and (x, z).
+    pub modes_per_plane: usize,
+    /// Axial stiffness `E A`, N (used when `axial_modes > 0`).
+    pub axial_stiffness: f64,
+    /// Axial modes.
+    pub axial_modes: usize,
+    /// Damping ratio of every mode.
+    pub damping_ratio: f64,
+}
+
 /// A mass-normalised modal basis restricted to named points.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModalBasis {
@@ -65,20 +84,15 @@ impl ModalBasis {
         })
     }
 
-    /// Analytic modes of a pinned–pinned Euler–Bernoulli beam along x, bending in y and z.
+    /// Analytic modes of a pinned–pinned Euler–Bernoulli beam along x, bending in y and z, and
+    /// optionally axial.
     ///
-    /// Mode `k` (k = 1..n) in each plane: `φ_k(x) = √(2/(ρA L)) sin(kπx/L)`,
-    /// `ω_k = (kπ/L)² √(EI/ρA)`. The modes are ordered by frequency, y before z at equal
-    /// frequency. Used by the multi-contact example and the synthetic benchmark case, where an
-    /// exact basis with many modes and many points is wanted without a finite-element model.
-    pub fn pinned_beam(
-        length: f64,
-        bending_stiffness: f64,
-        mass_per_length: f64,
-        modes_per_plane: usize,
-        damping_ratio: f64,
-        stations: &[(String, f64)],
-    ) -> Result<Self> {
+    /// Bending mode `k` (k = 1..n) in each plane: `φ_k(x) = √(2/(ρA L)) sin(kπx/L)`,
+    /// `ω_k = (kπ/L)² √(EI/ρA)`; axial mode `k` (ends held axially):
+    /// same shape along x, `ω_k = (kπ/L) √(EA/ρA)`. Modes are numbered y₁, z₁, y₂, z₂, …, y_n,
+    /// z_n, then x₁ … x_na. Used by the multi-contact example and the synthetic benchmark case,
+    /// where an exact basis with many modes and points is wanted without a finite-element model.
+    pub fn pinned_beam(beam: &PinnedBeam, stations: &[(String, f64)]) -> Result<Self> {
         let positive = |v: f64, field: &str, unit: &str| {
             if v.is_finite() && v > 0.0 {
                 Ok(())
@@ -89,24 +103,36 @@ impl ModalBasis {
                 ))
             }
         };
-        positive(length, "structure.length", "m")?;
-        positive(bending_stiffness, "structure.bending_stiffness", "N·m²")?;
-        positive(mass_per_length, "structure.mass_per_length", "kg/m")?;
-        if modes_per_plane == 0 {
+        positive(beam.length, "structure.length", "m")?;
+        positive(
+            beam.bending_stiffness,
+            "structure.bending_stiffness",
+            "N·m²",
+        )?;
+        positive(beam.mass_per_length, "structure.mass_per_length", "kg/m")?;
+        if beam.modes_per_plane == 0 {
             return Err(Error::invalid(
                 "structure.modes_per_plane",
                 "must be at least 1",
             ));
         }
-        check_damping_ratio(damping_ratio, "structure.damping_ratio")?;
-        let p = 2 * modes_per_plane;
-        let amp = (2.0 / (mass_per_length * length)).sqrt();
-        let c = (bending_stiffness / mass_per_length).sqrt();
+        if beam.axial_modes > 0 {
+            positive(beam.axial_stiffness, "structure.axial_stiffness", "N (E A)")?;
+        }
+        check_damping_ratio(beam.damping_ratio, "structure.damping_ratio")?;
+        let (length, n, na) = (beam.length, beam.modes_per_plane, beam.axial_modes);
+        let p = 2 * n + na;
+        let amp = (2.0 / (beam.mass_per_length * length)).sqrt();
+        let c_bend = (beam.bending_stiffness / beam.mass_per_length).sqrt();
+        let c_axial = (beam.axial_stiffness / beam.mass_per_length).sqrt();
+        let wave = |k: usize| k as f64 * std::f64::consts::PI / length;
         let mut omega = Vec::with_capacity(p);
-        for k in 1..=modes_per_plane {
-            let w = (k as f64 * std::f64::consts::PI / length).powi(2) * c;
-            omega.push(w);
-            omega.push(w);
+        for k in 1..=n {
+            omega.push(wave(k).powi(2) * c_bend);
+            omega.push(wave(k).powi(2) * c_bend);
+        }
+        for k in 1..=na {
+            omega.push(wave(k) * c_axial);
         }
         let mut points = Vec::with_capacity(stations.len());
         for (j, (name, x)) in stations.iter().enumerate() {
@@ -117,10 +143,13 @@ impl ModalBasis {
                 ));
             }
             let mut rows = vec![0.0; 3 * p];
-            for k in 1..=modes_per_plane {
-                let s = amp * (k as f64 * std::f64::consts::PI * x / length).sin();
+            for k in 1..=n {
+                let s = amp * (wave(k) * x).sin();
                 rows[p + 2 * (k - 1)] = s; // y row, y-mode
                 rows[2 * p + 2 * (k - 1) + 1] = s; // z row, z-mode
+            }
+            for k in 1..=na {
+                rows[2 * n + k - 1] = amp * (wave(k) * x).sin(); // x row, axial mode
             }
             points.push(Point {
                 name: name.clone(),
@@ -130,7 +159,7 @@ impl ModalBasis {
         }
         Ok(Self {
             omega,
-            damping_ratio: vec![damping_ratio; p],
+            damping_ratio: vec![beam.damping_ratio; p],
             points,
         })
     }

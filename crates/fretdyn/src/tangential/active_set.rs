@@ -5,9 +5,14 @@
 //!    a newly closed contact is guessed sliding along `b_i`, §4.5);
 //! 2. slip contacts: `λ_i = μ_d R_N,i d_i`;
 //! 3. stick contacts: `H_SS λ_S = b_S − H_SF λ_F` by Cholesky (regularised when singular, §4.6);
-//! 4. stick with `|λ_i| > μ_s R_N,i` → slip along its local free velocity
-//!    `b_i − Σ_{j≠i} H_ij λ_j`; slip whose velocity `(b − Hλ)_i` has reversed against `d_i` → stick;
-//!    slip directions are updated to that velocity;
+//! 4. each contact's status is then tested on its own local problem, the others frozen
+//!    (right-hand side `c_i = b_i − Σ_{j≠i} H_ij λ_j`, exact local solve of §4.4):
+//!    stick with `|λ_i| > μ_s R_N,i` → slip; slip whose local problem is a stick (for an
+//!    isotropic `H_ii` this is exactly the paper's test "the slip velocity `(b − Hλ)_i` has
+//!    reversed against `d_i`") → stick; a slip direction is the direction of the exact local
+//!    slip solution, which makes `λ_i ∥ w_i` even when `H_ii` is not a multiple of the identity
+//!    (the plain update `d ← w/|w|`, or a reversal test made with a wrong direction guess, does
+//!    not converge then);
 //! 5. stop when no status and no slip direction changes.
 //!
 //! A status pattern that comes back is a cycle; it and the iteration bound are counted and the
@@ -17,7 +22,7 @@ use nalgebra::Vector2;
 
 use super::{ActiveSetSettings, SolverStatistics, gauss_seidel};
 use crate::delassus::TangentialProblem;
-use crate::friction::Slide;
+use crate::friction::{LocalSolve, Slide, local_solve};
 
 /// Memory of a contact between steps: its last status and slip direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -104,7 +109,8 @@ impl ActiveSet {
             }
         }
         self.patterns.clear();
-        self.patterns.push(pattern(&self.stick[..m]));
+        self.patterns
+            .push(pattern(&self.stick[..m], &self.direction[..m]));
 
         let mut iterations = 0;
         let outcome = loop {
@@ -126,10 +132,16 @@ impl ActiveSet {
                 if self.stick[k] {
                     if lambda[k].norm() > slot.s_static * (1.0 + 1e-12) {
                         self.stick[k] = false;
-                        let c = problem.local_rhs(k, lambda);
-                        let nc = c.norm();
-                        self.direction[k] = if nc > 0.0 {
-                            c / nc
+                        let (local, _) = local_solve(
+                            &problem.block(k, k),
+                            &problem.local_rhs(k, lambda),
+                            slot.s_static,
+                            slot.s_dynamic,
+                            LocalSolve::Exact,
+                        );
+                        let n = local.norm();
+                        self.direction[k] = if n > 0.0 {
+                            local / n
                         } else {
                             lambda[k] / lambda[k].norm()
                         };
@@ -137,11 +149,19 @@ impl ActiveSet {
                     }
                 } else {
                     let w = problem.residual_velocity(k, lambda);
-                    if w.dot(&self.direction[k]) <= 0.0 {
+                    let (local, local_slide) = local_solve(
+                        &problem.block(k, k),
+                        &problem.local_rhs(k, lambda),
+                        slot.s_static,
+                        slot.s_dynamic,
+                        LocalSolve::Exact,
+                    );
+                    if local_slide == Slide::Stick {
                         self.stick[k] = true;
                         status_changed = true;
                     } else {
-                        let d = w / w.norm();
+                        let n = local.norm();
+                        let d = if n > 0.0 { local / n } else { w / w.norm() };
                         if (d - self.direction[k]).norm() > 1e-12 {
                             self.direction[k] = d;
                             direction_changed = true;
@@ -153,7 +173,7 @@ impl ActiveSet {
                 break Outcome::Converged(iterations);
             }
             if status_changed {
-                let pat = pattern(&self.stick[..m]);
+                let pat = pattern(&self.stick[..m], &self.direction[..m]);
                 if self.patterns.contains(&pat) {
                     break Outcome::Cycled(iterations);
                 }
@@ -195,13 +215,23 @@ impl ActiveSet {
     }
 }
 
-/// FNV-1a hash of a status vector. A collision could only make a new pattern look like a
-/// repeated one, which sends the step to the fallback: safe, and counted.
-fn pattern(stick: &[bool]) -> u64 {
+/// FNV-1a hash of the statuses and of the slip directions (rounded to 1e-9): a cycle is a
+/// state that comes back, not just a stick/slip pattern (a slip that reverses goes
+/// slip → stick → slip with the opposite direction, which is progress). A hash collision could
+/// only make a new state look like a repeated one, which sends the step to the fallback:
+/// safe, and counted.
+fn pattern(stick: &[bool], direction: &[Vector2<f64>]) -> u64 {
     let mut h: u64 = 0xcbf29ce484222325;
-    for &s in stick {
-        h ^= s as u64 + 1;
+    let mut mix = |v: u64| {
+        h ^= v;
         h = h.wrapping_mul(0x100000001b3);
+    };
+    for (&s, d) in stick.iter().zip(direction) {
+        mix(s as u64 + 1);
+        if !s {
+            mix((d.x * 1e9).round() as i64 as u64);
+            mix((d.y * 1e9).round() as i64 as u64);
+        }
     }
     h
 }
