@@ -1,1 +1,120 @@
-fn main() {}
+//! The `fretdyn` command: run case files, verify against the analytic solutions, benchmark.
+
+mod bench;
+mod plot;
+mod progress;
+mod run;
+mod verify;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Nonlinear vibration of structures on a modal basis rattling against obstacles with Coulomb
+/// friction (explicit central differences; penalty, Active Set or projected Gauss–Seidel).
+#[derive(Debug, Parser)]
+#[command(name = "fretdyn", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run a case file; without one, run the built-in demo (V1a with the three methods).
+    Run {
+        /// Case file (TOML). See examples/ for the reference of every key.
+        case: Option<PathBuf>,
+        /// Output folder [default: fretdyn_results/<case name>].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// No progress bar and no report on stdout.
+        #[arg(short, long)]
+        quiet: bool,
+        /// Do not write PNG plots.
+        #[arg(long)]
+        no_plots: bool,
+    },
+    /// Run V1a, V1b, V1c (THEORY §6) with every method, compare with the analytic solution,
+    /// write the figures; exit code 1 if a check fails.
+    Verify {
+        /// Output folder for figures and verification.json.
+        #[arg(short, long, default_value = "fretdyn_results/verify")]
+        output: PathBuf,
+        /// Print only failures and the final line.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+    /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube.
+    Bench {
+        /// Steps per run of the synthetic tube (V1 runs its 4000 steps, repeated).
+        #[arg(long, default_value_t = 200_000)]
+        steps: u64,
+        /// Repetitions; the best is reported.
+        #[arg(long, default_value_t = 3)]
+        repeat: usize,
+        /// Modes of the synthetic tube.
+        #[arg(long, default_value_t = 50)]
+        modes: usize,
+        /// Contacts of the synthetic tube.
+        #[arg(long, default_value_t = 8)]
+        contacts: usize,
+    },
+}
+
+/// Exit code of input errors (bad case file, bad option).
+pub const EXIT_INPUT: u8 = 2;
+/// Exit code of a run that failed (diverged, verification check failed).
+pub const EXIT_FAILED: u8 = 1;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let outcome = match cli.command {
+        Command::Run {
+            case,
+            output,
+            quiet,
+            no_plots,
+        } => run::main(case.as_deref(), output, quiet, !no_plots),
+        Command::Verify { output, quiet } => verify::main(&output, quiet),
+        Command::Bench {
+            steps,
+            repeat,
+            modes,
+            contacts,
+        } => bench::main(steps, repeat, modes, contacts),
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(failure) => {
+            eprintln!("error: {}", failure.message);
+            ExitCode::from(failure.code)
+        }
+    }
+}
+
+/// A failure to report: a one-line message and the exit code.
+#[derive(Debug)]
+pub struct Failure {
+    pub message: String,
+    pub code: u8,
+}
+
+impl Failure {
+    /// An input error (exit code 2).
+    pub fn input(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+            code: EXIT_INPUT,
+        }
+    }
+
+    /// A failed run or check (exit code 1).
+    pub fn failed(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+            code: EXIT_FAILED,
+        }
+    }
+}

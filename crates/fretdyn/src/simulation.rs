@@ -102,6 +102,17 @@ fn check_gs(g: &crate::tangential::GaussSeidelSettings, field: &str) -> Result<(
     Ok(())
 }
 
+/// `x` rounded down to 3 significant digits, for the time step suggested to the user.
+fn round_down(x: f64) -> f64 {
+    if !(x.is_finite() && x > 0.0) {
+        return x;
+    }
+    let exponent = x.log10().floor() as i32 - 2;
+    let digits = (x / 10f64.powi(exponent)).floor();
+    // through the decimal text, so that it prints as typed (1.8e-3, not 1.8000000000000002e-3)
+    format!("{digits}e{exponent}").parse().unwrap_or(x)
+}
+
 /// Progress report passed to the observer of [`run`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Progress {
@@ -184,7 +195,7 @@ pub fn run(
         return Err(Error::UnstableTimeStep {
             dt: settings.dt,
             limit: stable_dt,
-            suggest: 0.9 * stable_dt,
+            suggest: round_down(0.9 * stable_dt),
         });
     }
     let mut sim = Simulation::new(model, settings, stable_dt);

@@ -1,0 +1,62 @@
+//! A progress bar on stderr, shown only for runs that last more than a second.
+
+use std::ops::ControlFlow;
+use std::time::{Duration, Instant};
+
+use fretdyn::simulation::Progress;
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// Observer for [`fretdyn::simulation::run`] that shows a bar after `delay`.
+pub struct Bar {
+    start: Instant,
+    delay: Duration,
+    bar: Option<ProgressBar>,
+    enabled: bool,
+    label: String,
+}
+
+impl Bar {
+    /// A bar labelled `label`; `enabled = false` never draws.
+    pub fn new(label: &str, enabled: bool) -> Self {
+        Self {
+            start: Instant::now(),
+            delay: Duration::from_secs(1),
+            bar: None,
+            enabled,
+            label: label.to_string(),
+        }
+    }
+
+    /// The observer callback.
+    pub fn observe(&mut self, p: Progress) -> ControlFlow<()> {
+        if !self.enabled {
+            return ControlFlow::Continue(());
+        }
+        if self.bar.is_none() && self.start.elapsed() >= self.delay && p.step < p.total {
+            let bar = ProgressBar::new(p.total);
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{msg} [{bar:40}] {pos}/{len} steps, {per_sec}, eta {eta}",
+                )
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+            );
+            bar.set_message(self.label.clone());
+            self.bar = Some(bar);
+        }
+        if let Some(bar) = &self.bar {
+            bar.set_position(p.step);
+            if p.step >= p.total {
+                bar.finish_and_clear();
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Clears the bar.
+    pub fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+    }
+}

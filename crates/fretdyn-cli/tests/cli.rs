@@ -1,0 +1,255 @@
+//! The `fretdyn` command as a user meets it: outputs of a run, and one-line errors with a
+//! non-zero exit code and no output for bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn fretdyn(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("fretdyn runs")
+}
+
+fn examples() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
+}
+
+/// A fresh scratch folder.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("fretdyn-cli-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+const V1A: &str = include_str!("../../../examples/v1a_oblique_impact.toml");
+
+#[test]
+fn run_writes_npz_summary_and_plot() {
+    let s = Scratch::new("run");
+    let case = examples().join("v1a_oblique_impact.toml");
+    let out = fretdyn(
+        &["run", case.to_str().unwrap(), "-o", "out", "--quiet"],
+        &s.0,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let dir = s.0.join("out");
+    for f in ["results.npz", "summary.json", "contact_forces.png"] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    let mut npz =
+        ndarray_npy::NpzReader::new(std::fs::File::open(dir.join("results.npz")).unwrap()).unwrap();
+    let t: ndarray::Array1<f64> = npz.by_name("t").unwrap();
+    let rn: ndarray::Array2<f64> = npz.by_name("contact_normal_force").unwrap();
+    let rt: ndarray::Array3<f64> = npz.by_name("contact_tangential_force").unwrap();
+    let st: ndarray::Array2<i8> = npz.by_name("contact_status").unwrap();
+    assert_eq!(t.len(), 4001);
+    assert_eq!(rn.shape(), [4001, 1]);
+    assert_eq!(rt.shape(), [4001, 1, 2]);
+    assert!(st.iter().all(|s| (0..=2).contains(s)));
+    // the peak normal force is m v_n ω (THEORY §6)
+    let peak = rn.iter().copied().fold(0.0, f64::max);
+    let expected = 20f64.to_radians().cos() * 1000.0;
+    assert!((peak - expected).abs() < 1e-3 * expected, "{peak}");
+
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["termination"]["status"], "completed");
+    assert_eq!(summary["time"]["steps"], 4000);
+    let c = &summary["contacts"][0];
+    assert_eq!(c["name"], "plane");
+    assert_eq!(c["impacts"], 1);
+    // all the tangential kinetic energy ½ m (V sin α)² is dissipated by friction before the stick
+    let wear = c["wear_work"].as_f64().unwrap();
+    let analytic = 0.5 * 20f64.to_radians().sin().powi(2);
+    assert!(
+        (wear - analytic).abs() < 1e-4 * analytic,
+        "{wear} vs {analytic}"
+    );
+    assert!(
+        summary["energy_balance"]["relative_error"]
+            .as_f64()
+            .unwrap()
+            < 1e-6
+    );
+    assert!(summary["performance"]["steps_per_second"].as_f64().unwrap() > 0.0);
+    assert_eq!(summary["case"]["tangential"]["method"], "gauss_seidel");
+}
+
+#[test]
+fn demo_runs_three_methods() {
+    let s = Scratch::new("demo");
+    let out = fretdyn(&["run", "-o", "demo"], &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("demo written to demo"), "{stdout}");
+    for m in ["active_set", "gauss_seidel", "penalty"] {
+        assert!(
+            s.0.join("demo").join(m).join("results.npz").is_file(),
+            "{m}"
+        );
+    }
+    assert!(s.0.join("demo/friction_force.png").is_file());
+}
+
+/// Writes `case` to a file, runs it, and checks: exit code 2, one line on stderr naming the
+/// file and containing every `needles`, nothing written.
+fn assert_input_error(name: &str, case: &str, needles: &[&str]) {
+    let s = Scratch::new(name);
+    std::fs::write(s.0.join("case.toml"), case).unwrap();
+    let out = fretdyn(&["run", "case.toml", "-o", "out"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{name}: {stderr}");
+    assert_eq!(
+        stderr.trim_end().lines().count(),
+        1,
+        "{name}: not one line: {stderr}"
+    );
+    assert!(stderr.starts_with("error: case.toml: "), "{name}: {stderr}");
+    for n in needles {
+        assert!(stderr.contains(n), "{name}: '{n}' not in: {stderr}");
+    }
+    assert!(
+        !s.0.join("out").exists(),
+        "{name}: output written for a bad input"
+    );
+    assert!(!stderr.contains("panicked"), "{name}: {stderr}");
+}
+
+#[test]
+fn time_step_above_the_stable_limit() {
+    // ω = 1000 rad/s: the limit is 2 ms
+    let case = V1A.replace("dt = 1e-6 ", "dt = 3e-3 ");
+    assert_input_error(
+        "dt",
+        &case,
+        &["time.dt", "stable limit 2e-3", "set time.dt ≤ 1.8e-3"],
+    );
+}
+
+#[test]
+fn negative_mass() {
+    let case = V1A.replace("mass = 1.0 ", "mass = -1.0 ");
+    assert_input_error("mass", &case, &["structure.mass", "positive"]);
+}
+
+#[test]
+fn negative_contact_stiffness() {
+    let case = V1A.replace("stiffness = 1e6,", "stiffness = -1e6,");
+    assert_input_error("kn", &case, &["contacts[0].normal.stiffness", "positive"]);
+}
+
+#[test]
+fn non_finite_mode_shape() {
+    let case = include_str!("../../../examples/v1a_modal_inline.toml")
+        .replace("[0.0, 1.0, 0.0],", "[0.0, nan, 0.0],");
+    assert_input_error(
+        "nan",
+        &case,
+        &["structure.points.mass.rows", "not finite", "y", "mode 1"],
+    );
+}
+
+#[test]
+fn unknown_key() {
+    let case = V1A.replace("duration = 4e-3", "duration = 4e-3\nstep = 2");
+    assert_input_error("key", &case, &["line 18", "unknown field `step`", "dt"]);
+}
+
+#[test]
+fn unknown_method() {
+    let case = V1A.replace("method = \"gauss_seidel\"", "method = \"newton\"");
+    assert_input_error(
+        "method",
+        &case,
+        &["newton", "gauss_seidel", "active_set", "penalty"],
+    );
+}
+
+#[test]
+fn missing_modal_file() {
+    let case =
+        "[time]\ndt = 1e-6\nduration = 1e-3\n[structure]\ntype = \"modal\"\nfile = \"basis.npz\"\n";
+    assert_input_error("npz", case, &["basis.npz", "No such file"]);
+}
+
+#[test]
+fn missing_case_file() {
+    let s = Scratch::new("nofile");
+    let out = fretdyn(&["run", "nothere.toml"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr.contains("nothere.toml") && stderr.contains("No such file"),
+        "{stderr}"
+    );
+    assert!(!s.0.join("fretdyn_results").exists());
+}
+
+/// A run that blows up stops with the step where it happened and keeps what it computed.
+#[test]
+fn divergence_stops_with_the_step_and_keeps_results() {
+    let s = Scratch::new("diverge");
+    let case = V1A.replace(
+        "[output]",
+        "[[loads]]\npoint = \"mass\"\nforce = [0.0, 1e307, 0.0]\n\n[output]",
+    );
+    std::fs::write(s.0.join("case.toml"), case).unwrap();
+    let out = fretdyn(&["run", "case.toml", "-o", "out", "--quiet"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("diverged at step"), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(s.0.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["termination"]["status"], "diverged");
+    let step = summary["termination"]["step"].as_u64().unwrap();
+    assert!(step > 0 && step < 4000, "{summary}");
+    let mut npz =
+        ndarray_npy::NpzReader::new(std::fs::File::open(s.0.join("out/results.npz")).unwrap())
+            .unwrap();
+    let q: ndarray::Array2<f64> = npz.by_name("q").unwrap();
+    assert!(q.nrows() as u64 <= step && q.nrows() > 0);
+    assert!(
+        q.iter().all(|v| v.is_finite()),
+        "only finite samples are kept"
+    );
+}
+
+#[test]
+fn verify_passes() {
+    let s = Scratch::new("verify");
+    let out = fretdyn(&["verify", "-o", "v", "--quiet"], &s.0);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    assert!(stdout.contains(" 0 failed"), "{stdout}");
+    for f in [
+        "fig2a_v1a_friction_force.png",
+        "fig2b_v1b_friction_force.png",
+        "full_step_variant.png",
+        "penalty_kt_dependence.png",
+        "verification.json",
+    ] {
+        assert!(s.0.join("v").join(f).is_file(), "{f}");
+    }
+}
