@@ -48,7 +48,7 @@ enum Command {
     },
     /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube.
     Bench {
-        /// Steps per run of the synthetic tube (V1 runs its 4000 steps, repeated).
+        /// Steps per run of the synthetic tube (V1 runs its 4000 steps, 20 × repeat times).
         #[arg(long, default_value_t = 200_000)]
         steps: u64,
         /// Repetitions; the best is reported.

@@ -11,6 +11,8 @@
 //!
 //! and whatever λ is, the tangential velocity the constraint sees is `v_imp + θ Δt (b − H λ)`.
 //! All buffers are sized once for every contact being closed: assembling allocates nothing.
+//! The rows of a contact whose tangent basis never changes (a fixed plane) are computed once,
+//! and so are the blocks of `H` between two such contacts: a step then only gathers them.
 
 use nalgebra::{Matrix2, Vector2, Vector3};
 
@@ -30,19 +32,24 @@ pub struct Slot {
 pub struct TangentialProblem {
     p: usize,
     slots: Vec<Slot>,
-    /// `L`, 2 rows of p per slot.
+    /// `L` rows, stored per contact (rows `2c`, `2c + 1` of contact `c`), p values each.
     l: Vec<f64>,
-    /// `A⁻¹ Lᵀ` stored as rows: `al[r] = A⁻¹ ∘ l[r]`.
+    /// `A⁻¹ Lᵀ` stored as rows: `al[r] = A⁻¹ ∘ l[r]`, same layout.
     al: Vec<f64>,
-    /// `H`, dense, row stride `2 * capacity`.
+    /// Contacts whose rows are computed once ([`fix_rows`](Self::fix_rows)).
+    fixed: Vec<bool>,
+    /// `H` between fixed contacts, indexed by contact rows, row stride `2 * capacity`.
+    h_fixed: Vec<f64>,
+    /// `H` of the closed contacts, indexed by slot rows, row stride `2 * capacity`.
     h: Vec<f64>,
-    /// Right-hand side `b`.
+    /// Right-hand side `b`, by slot rows.
     b: Vec<f64>,
     stride: usize,
 }
 
 impl TangentialProblem {
-    /// Workspace for up to `contacts` closed contacts on `p` modes.
+    /// Workspace for up to `contacts` closed contacts on `p` modes; contact indices of the
+    /// slots must be below `contacts`.
     pub fn new(p: usize, contacts: usize) -> Self {
         let rows = 2 * contacts;
         Self {
@@ -50,10 +57,69 @@ impl TangentialProblem {
             slots: Vec::with_capacity(contacts),
             l: vec![0.0; rows * p],
             al: vec![0.0; rows * p],
+            fixed: vec![false; contacts],
+            h_fixed: vec![0.0; rows * rows],
             h: vec![0.0; rows * rows],
             b: vec![0.0; rows],
             stride: rows,
         }
+    }
+
+    /// Declares that `contact` always has the tangent basis `tangents`: its rows, and its
+    /// blocks of `H` with the other fixed contacts, are computed now, once.
+    pub fn fix_rows(
+        &mut self,
+        contact: usize,
+        tangents: &[Vector3<f64>; 2],
+        rows: &[f64],
+        a_inv: &[f64],
+    ) {
+        self.fixed[contact] = false;
+        self.compute_rows(contact, tangents, rows, a_inv);
+        self.fixed[contact] = true;
+        let p = self.p;
+        for other in 0..self.fixed.len() {
+            if !self.fixed[other] {
+                continue;
+            }
+            for a in 0..2 {
+                for b in 0..2 {
+                    let (r, c) = (2 * contact + a, 2 * other + b);
+                    let v = crate::modal::dot(
+                        &self.l[r * p..(r + 1) * p],
+                        &self.al[c * p..(c + 1) * p],
+                    );
+                    self.h_fixed[r * self.stride + c] = v;
+                    self.h_fixed[c * self.stride + r] = v;
+                }
+            }
+        }
+    }
+
+    fn compute_rows(
+        &mut self,
+        contact: usize,
+        tangents: &[Vector3<f64>; 2],
+        rows: &[f64],
+        a_inv: &[f64],
+    ) {
+        let p = self.p;
+        for (a, t) in tangents.iter().enumerate() {
+            let r = 2 * contact + a;
+            let l = &mut self.l[r * p..(r + 1) * p];
+            let al = &mut self.al[r * p..(r + 1) * p];
+            for i in 0..p {
+                let v = t.x * rows[i] + t.y * rows[p + i] + t.z * rows[2 * p + i];
+                l[i] = v;
+                al[i] = v * a_inv[i];
+            }
+        }
+    }
+
+    /// Row of `L` (in the per-contact layout) of slot row `r`.
+    #[inline]
+    fn contact_row(&self, r: usize) -> usize {
+        2 * self.slots[r / 2].contact + r % 2
     }
 
     /// Removes every slot.
@@ -81,26 +147,18 @@ impl TangentialProblem {
     }
 
     /// Adds a closed contact with its tangent basis, point rows (3 × p), and the diagonal of
-    /// `A⁻¹`; the contact's velocity terms enter `b` when [`assemble`](Self::assemble) is called.
+    /// `A⁻¹` (ignored for a contact whose rows were fixed); the contact's velocity terms enter
+    /// `b` when [`assemble`](Self::assemble) is called.
     #[inline]
     pub fn push(&mut self, slot: Slot, tangents: &[Vector3<f64>; 2], rows: &[f64], a_inv: &[f64]) {
-        let p = self.p;
-        let k = self.slots.len();
-        self.slots.push(slot);
-        for (a, t) in tangents.iter().enumerate() {
-            let r = 2 * k + a;
-            let l = &mut self.l[r * p..(r + 1) * p];
-            let al = &mut self.al[r * p..(r + 1) * p];
-            for i in 0..p {
-                let v = t.x * rows[i] + t.y * rows[p + i] + t.z * rows[2 * p + i];
-                l[i] = v;
-                al[i] = v * a_inv[i];
-            }
+        if !self.fixed[slot.contact] {
+            self.compute_rows(slot.contact, tangents, rows, a_inv);
         }
+        self.slots.push(slot);
     }
 
-    /// Assembles `H` and `b = L q̈_free + (L q̇* − v_imp)/(θΔt)`. `v_imp(slot)` gives the obstacle's
-    /// tangential velocity at a slot's contact, in its tangent basis.
+    /// Assembles `H` and `b = L q̈_free + (L q̇* − v_imp)/(θΔt)`. `v_imp(slot)` gives the
+    /// obstacle's tangential velocity at a slot's contact, in its tangent basis.
     pub fn assemble(
         &mut self,
         qdd_free: &[f64],
@@ -111,10 +169,16 @@ impl TangentialProblem {
         let p = self.p;
         let n = 2 * self.slots.len();
         for r in 0..n {
-            let lr = &self.l[r * p..(r + 1) * p];
+            let lr_index = self.contact_row(r);
+            let lr = &self.l[lr_index * p..(lr_index + 1) * p];
+            let fixed_r = self.fixed[lr_index / 2];
             for c in r..n {
-                let alc = &self.al[c * p..(c + 1) * p];
-                let v = crate::modal::dot(lr, alc);
+                let lc_index = self.contact_row(c);
+                let v = if fixed_r && self.fixed[lc_index / 2] {
+                    self.h_fixed[lr_index * self.stride + lc_index]
+                } else {
+                    crate::modal::dot(lr, &self.al[lc_index * p..(lc_index + 1) * p])
+                };
                 self.h[r * self.stride + c] = v;
                 self.h[c * self.stride + r] = v;
             }
@@ -171,7 +235,7 @@ impl TangentialProblem {
         let p = self.p;
         for (k, lam) in lambda.iter().enumerate().take(self.slots.len()) {
             for a in 0..2 {
-                let r = 2 * k + a;
+                let r = self.contact_row(2 * k + a);
                 let al = &self.al[r * p..(r + 1) * p];
                 let s = lam[a];
                 if s != 0.0 {

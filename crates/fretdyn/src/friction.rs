@@ -120,17 +120,18 @@ pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
 /// the secular equation `Σ c_k²/(s h_k + t)² = 1`, solved by Newton on `φ(t) = 1/|u(t)| − 1`,
 /// which is concave and increasing so Newton from `t = 0` converges monotonically.
 fn disk_boundary_solve(h: &Matrix2<f64>, c: &Vector2<f64>, s: f64) -> Vector2<f64> {
-    let eig = h.symmetric_eigen();
-    let q = eig.eigenvectors;
-    let hs = [s * eig.eigenvalues[0], s * eig.eigenvalues[1]];
+    let (q, eigenvalues) = symmetric_eigen2(h);
+    let hs = [s * eigenvalues[0], s * eigenvalues[1]];
     let cp = q.transpose() * c;
     let norm_u = |t: f64| {
         let a = cp[0] / (hs[0] + t);
         let b = cp[1] / (hs[1] + t);
         (a * a + b * b).sqrt()
     };
-    // Lower end: t where the smallest shifted eigenvalue is still positive.
-    let mut t = (-hs[0].min(hs[1])).max(0.0);
+    // Start below the root: |c| = |(sH + tI)u| ≤ s h_max + t gives t* ≥ |c| − s h_max.
+    let mut t = (-hs[0].min(hs[1]))
+        .max(c.norm() - hs[0].max(hs[1]))
+        .max(0.0);
     if !(norm_u(t) > 1.0) {
         // Only possible through round-off at the disk edge: project radially.
         let free = solve2(h, c);
@@ -154,8 +155,36 @@ fn disk_boundary_solve(h: &Matrix2<f64>, c: &Vector2<f64>, s: f64) -> Vector2<f6
     u * (s / u.norm())
 }
 
+/// Eigen-decomposition `H = Q diag(h) Qᵀ` of a symmetric 2 × 2 matrix, in closed form
+/// (Jacobi rotation by `θ = ½ atan2(2 h₁₂, h₁₁ − h₂₂)`).
+#[inline]
+fn symmetric_eigen2(h: &Matrix2<f64>) -> (Matrix2<f64>, [f64; 2]) {
+    let (a, b, d) = (h[(0, 0)], 0.5 * (h[(0, 1)] + h[(1, 0)]), h[(1, 1)]);
+    let theta = 0.5 * (2.0 * b).atan2(a - d);
+    let (sn, cs) = theta.sin_cos();
+    let q = Matrix2::new(cs, -sn, sn, cs);
+    let e0 = a * cs * cs + 2.0 * b * sn * cs + d * sn * sn;
+    let e1 = a * sn * sn - 2.0 * b * sn * cs + d * cs * cs;
+    (q, [e0, e1])
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn closed_form_eigen_reconstructs_the_matrix() {
+        for h in [
+            Matrix2::new(2.0, 0.7, 0.7, 0.5),
+            Matrix2::new(1.0, 0.0, 0.0, 4.0),
+            Matrix2::new(3.0, -1.0, -1.0, 3.0),
+            Matrix2::new(1.0, 0.0, 0.0, 1.0),
+        ] {
+            let (q, e) = symmetric_eigen2(&h);
+            let back = q * Matrix2::new(e[0], 0.0, 0.0, e[1]) * q.transpose();
+            assert!((back - h).norm() < 1e-14 * h.norm(), "{h} vs {back}");
+            assert!((q.transpose() * q - Matrix2::identity()).norm() < 1e-15);
+        }
+    }
+
     use super::*;
 
     /// The exact local solution satisfies the slip condition `λ ∥ c − Hλ`, `|λ| = s`;

@@ -134,6 +134,14 @@ impl Obstacle {
         }
     }
 
+    /// The tangent basis, when it does not depend on the position or time (a fixed plane):
+    /// the Delassus rows of such a contact are computed once.
+    pub fn fixed_tangents(&self) -> Option<[Vector3<f64>; 2]> {
+        match self {
+            Obstacle::Plane(p) => Some(p.tangents),
+        }
+    }
+
     /// Directions along which the penalty stiffnesses act, for the stability bound: the
     /// normal and the tangents. For a plane they do not depend on the position.
     pub fn stiffness_directions(&self) -> (Vector3<f64>, [Vector3<f64>; 2]) {

@@ -322,11 +322,11 @@ impl<'m> Simulation<'m> {
                 contacts: vec![PenaltyContact::default(); nc],
             },
             TangentialMethod::GaussSeidel(s) => {
-                Tangential::lagrange(p, nc, settings, LagrangeSolver::GaussSeidel(s))
+                Tangential::lagrange(model, &cd.a_inv, settings, LagrangeSolver::GaussSeidel(s))
             }
             TangentialMethod::ActiveSet(s) => Tangential::lagrange(
-                p,
-                nc,
+                model,
+                &cd.a_inv,
                 settings,
                 LagrangeSolver::ActiveSet(Box::new(ActiveSet::new(s, nc))),
             ),
@@ -381,6 +381,7 @@ impl<'m> Simulation<'m> {
         }
         let (e, powers) = self.energy_and_powers();
         self.energy = EnergyBalance::start(e, powers);
+        self.full_step_velocities(true);
         self.sample();
     }
 
@@ -456,11 +457,16 @@ impl<'m> Simulation<'m> {
             let pt = &self.model.basis.points[c.point];
             state.x = pt.coords + recombine(&pt.rows, &self.cd.q);
             state.frame = c.frame(&state.x);
-            state.v = recombine(&pt.rows, velocity) - state.frame.velocity;
-            let rate = -state.frame.normal.dot(&state.v);
-            state.normal_force = c.normal.force(state.frame.penetration, rate);
             state.closed = state.frame.penetration > 0.0;
             state.tangential_force = Vector2::zeros();
+            if state.closed {
+                // an open contact's velocity is only needed at output samples
+                state.v = recombine(&pt.rows, velocity) - state.frame.velocity;
+                let rate = -state.frame.normal.dot(&state.v);
+                state.normal_force = c.normal.force(state.frame.penetration, rate);
+            } else {
+                state.normal_force = 0.0;
+            }
         }
     }
 
@@ -675,9 +681,21 @@ impl<'m> Simulation<'m> {
 }
 
 impl Tangential {
-    fn lagrange(p: usize, nc: usize, settings: &RunSettings, solver: LagrangeSolver) -> Self {
+    fn lagrange(
+        model: &Model,
+        a_inv: &[f64],
+        settings: &RunSettings,
+        solver: LagrangeSolver,
+    ) -> Self {
+        let nc = model.contacts.len();
+        let mut problem = TangentialProblem::new(model.basis.modes(), nc);
+        for (k, c) in model.contacts.iter().enumerate() {
+            if let Some(t) = c.obstacle.fixed_tangents() {
+                problem.fix_rows(k, &t, &model.basis.points[c.point].rows, a_inv);
+            }
+        }
         Tangential::Lagrange {
-            problem: TangentialProblem::new(p, nc),
+            problem,
             solver,
             theta_dt: settings.stick_velocity.theta() * settings.dt,
             lambda: vec![Vector2::zeros(); nc],

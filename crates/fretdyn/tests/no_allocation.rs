@@ -1,0 +1,69 @@
+//! The time-step loop allocates nothing: a run of 10× more steps makes exactly as many heap
+//! allocations (all of them in the set-up and in the results), counted by a global allocator.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use fretdyn::benchmark::rattling_tube;
+use fretdyn::simulation::simulate;
+use fretdyn::tangential::{
+    ActiveSetSettings, GaussSeidelSettings, PenaltySettings, TangentialMethod,
+};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations_of_run(method: TangentialMethod, steps: u64) -> (usize, u64) {
+    let mut case = rattling_tube(10, 4, method, steps);
+    case.settings.output_every = 100;
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let r = simulate(&case.model, &case.settings).expect("valid case");
+    (
+        ALLOCATIONS.load(Ordering::Relaxed) - before,
+        r.solver.lagrange_steps,
+    )
+}
+
+#[test]
+fn the_step_loop_does_not_allocate() {
+    for method in [
+        TangentialMethod::Penalty(PenaltySettings {
+            stiffness: 1e6,
+            damping: 10.0,
+        }),
+        TangentialMethod::ActiveSet(ActiveSetSettings::default()),
+        TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
+    ] {
+        let (short, _) = allocations_of_run(method, 2_000);
+        let (long, contact_steps) = allocations_of_run(method, 20_000);
+        assert!(
+            method.is_lagrange() == (contact_steps > 1000),
+            "{}: the run must exercise the contact solver ({contact_steps} steps)",
+            method.name()
+        );
+        assert_eq!(
+            short,
+            long,
+            "{}: {short} allocations for 2 000 steps, {long} for 20 000",
+            method.name()
+        );
+    }
+}
