@@ -32,20 +32,24 @@ impl Bar {
         if !self.enabled {
             return ControlFlow::Continue(());
         }
-        if self.bar.is_none() && self.start.elapsed() >= self.delay && p.step < p.total {
+        let elapsed = self.start.elapsed();
+        if self.bar.is_none() && elapsed >= self.delay && p.step < p.total {
             let bar = ProgressBar::new(p.total);
             bar.set_style(
-                ProgressStyle::with_template(
-                    "{msg} [{bar:40}] {pos}/{len} steps, {per_sec}, eta {eta}",
-                )
-                .unwrap_or_else(|_| ProgressStyle::default_bar())
-                .progress_chars("=> "),
+                ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} steps, {msg}")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar())
+                    .progress_chars("=> "),
             );
-            bar.set_message(self.label.clone());
+            bar.set_prefix(self.label.clone());
             self.bar = Some(bar);
         }
         if let Some(bar) = &self.bar {
+            // Rate and remaining time from the run's own clock: the bar starts late, so its
+            // own estimator would see the first jump as instantaneous.
+            let rate = p.step as f64 / elapsed.as_secs_f64().max(1e-9);
+            let eta = (p.total - p.step) as f64 / rate.max(1e-9);
             bar.set_position(p.step);
+            bar.set_message(format!("{rate:.3e} steps/s, {eta:.0} s left"));
             if p.step >= p.total {
                 bar.finish_and_clear();
             }
