@@ -13,45 +13,90 @@
 //! Steps 3, 4 and 6 (contacts) are done by the caller between [`predict`](CentralDifference::predict)
 //! and [`correct`](CentralDifference::correct). Damping enters through `A` so that it acts on
 //! `q̇_{n+1}`: the scheme is Newmark (β = 0, γ = ½), stable for `Δt < 2/ω_max` with any damping.
+//!
+//! The same steps run on physical coordinates (`A = M + (Δt/2) C`, dense) for the reference
+//! solver of [`Coordinates::Physical`]: with every mode kept the two give the same motion.
 
-use crate::modal::ModalBasis;
+use nalgebra::{DMatrix, DVector};
+
+use crate::model::{Coordinates, Model};
+
+/// The linear operators of the coordinates.
+#[derive(Debug, Clone)]
+enum Operators {
+    /// Modal: `M = I`, `K = diag(ω²)`, `C = diag(2ξω)`, `A⁻¹` diagonal.
+    Modal {
+        omega2: Vec<f64>,
+        damping: Vec<f64>,
+        a_inv: Vec<f64>,
+    },
+    /// Physical: dense `M`, `C`, `K`, `A⁻¹` and `M⁻¹`.
+    Dense {
+        mass: DMatrix<f64>,
+        damping: DMatrix<f64>,
+        stiffness: DMatrix<f64>,
+        a_inv: DMatrix<f64>,
+        m_inv: DMatrix<f64>,
+        work: DVector<f64>,
+    },
+}
 
 /// State and constants of the integrator.
 #[derive(Debug, Clone)]
 pub struct CentralDifference {
     /// Time step Δt, s.
     pub dt: f64,
-    omega2: Vec<f64>,
-    damping: Vec<f64>,
-    /// Diagonal of `A⁻¹`.
-    pub a_inv: Vec<f64>,
-    /// Modal displacements `q_n`.
+    operators: Operators,
+    /// Displacements `q_n`.
     pub q: Vec<f64>,
-    /// Modal velocities `q̇_n` (full step).
+    /// Velocities `q̇_n` (full step).
     pub qd: Vec<f64>,
-    /// Modal accelerations `q̈_n`.
+    /// Accelerations `q̈_n`.
     pub qdd: Vec<f64>,
     /// Predicted velocity `q̇*` of the current step.
     pub qd_star: Vec<f64>,
 }
 
 impl CentralDifference {
-    /// Integrator for `basis` at rest; set `q`, `qd` then call [`start`](Self::start).
-    pub fn new(basis: &ModalBasis, dt: f64) -> Self {
+    /// Integrator for `model` at rest; set `q`, `qd` then call [`start`](Self::start).
+    /// The model must have been validated (a physical mass matrix is then positive definite).
+    pub fn new(model: &Model, dt: f64) -> Self {
+        let basis = &model.basis;
         let p = basis.modes();
-        let omega2: Vec<f64> = basis.omega.iter().map(|w| w * w).collect();
-        let damping: Vec<f64> = basis
-            .omega
-            .iter()
-            .zip(&basis.damping_ratio)
-            .map(|(w, xi)| 2.0 * xi * w)
-            .collect();
-        let a_inv = damping.iter().map(|c| 1.0 / (1.0 + 0.5 * dt * c)).collect();
+        let operators = match &model.coordinates {
+            Coordinates::Modal => {
+                let damping: Vec<f64> = basis
+                    .omega
+                    .iter()
+                    .zip(&basis.damping_ratio)
+                    .map(|(w, xi)| 2.0 * xi * w)
+                    .collect();
+                Operators::Modal {
+                    omega2: basis.omega.iter().map(|w| w * w).collect(),
+                    a_inv: damping.iter().map(|c| 1.0 / (1.0 + 0.5 * dt * c)).collect(),
+                    damping,
+                }
+            }
+            Coordinates::Physical(m) => {
+                let a = &m.mass + &m.damping * (0.5 * dt);
+                let inverse = |x: DMatrix<f64>| {
+                    x.cholesky()
+                        .map(|c| c.inverse())
+                        .unwrap_or_else(|| DMatrix::zeros(p, p))
+                };
+                Operators::Dense {
+                    a_inv: inverse(a),
+                    m_inv: inverse(m.mass.clone()),
+                    mass: m.mass.clone(),
+                    damping: m.damping.clone(),
+                    stiffness: m.stiffness.clone(),
+                    work: DVector::zeros(p),
+                }
+            }
+        };
         Self {
             dt,
-            omega2,
-            damping,
-            a_inv,
+            operators,
             q: vec![0.0; p],
             qd: vec![0.0; p],
             qdd: vec![0.0; p],
@@ -59,10 +104,33 @@ impl CentralDifference {
         }
     }
 
-    /// Initial acceleration `q̈_0 = f_0 − Ω² q_0 − C_m q̇_0` from the modal force at t = 0.
+    /// Initial acceleration `q̈_0 = M⁻¹ (f_0 − K q_0 − C q̇_0)` from the force at t = 0.
     pub fn start(&mut self, force: &[f64]) {
-        for i in 0..self.q.len() {
-            self.qdd[i] = force[i] - self.omega2[i] * self.q[i] - self.damping[i] * self.qd[i];
+        match &mut self.operators {
+            Operators::Modal {
+                omega2, damping, ..
+            } => {
+                for i in 0..self.q.len() {
+                    self.qdd[i] = force[i] - omega2[i] * self.q[i] - damping[i] * self.qd[i];
+                }
+            }
+            Operators::Dense {
+                damping,
+                stiffness,
+                m_inv,
+                work,
+                ..
+            } => {
+                residual(force, stiffness, &self.q, damping, &self.qd, work);
+                for (i, out) in self.qdd.iter_mut().enumerate() {
+                    *out = m_inv
+                        .row(i)
+                        .iter()
+                        .zip(work.iter())
+                        .map(|(a, w)| a * w)
+                        .sum();
+                }
+            }
         }
     }
 
@@ -77,12 +145,54 @@ impl CentralDifference {
         }
     }
 
-    /// Step 5: `q̈_free = A⁻¹ (f − Ω² q − C_m q̇*)`, written to `self.qdd`.
+    /// Step 5: `q̈_free = A⁻¹ (f − K q − C q̇*)`, written to `self.qdd`.
     #[inline]
     pub fn free_acceleration(&mut self, force: &[f64]) {
-        for i in 0..self.q.len() {
-            self.qdd[i] = self.a_inv[i]
-                * (force[i] - self.omega2[i] * self.q[i] - self.damping[i] * self.qd_star[i]);
+        match &mut self.operators {
+            Operators::Modal {
+                omega2,
+                damping,
+                a_inv,
+            } => {
+                for i in 0..self.q.len() {
+                    self.qdd[i] = a_inv[i]
+                        * (force[i] - omega2[i] * self.q[i] - damping[i] * self.qd_star[i]);
+                }
+            }
+            Operators::Dense {
+                damping,
+                stiffness,
+                a_inv,
+                work,
+                ..
+            } => {
+                residual(force, stiffness, &self.q, damping, &self.qd_star, work);
+                for (i, out) in self.qdd.iter_mut().enumerate() {
+                    *out = a_inv
+                        .row(i)
+                        .iter()
+                        .zip(work.iter())
+                        .map(|(a, w)| a * w)
+                        .sum();
+                }
+            }
+        }
+    }
+
+    /// `out = A⁻¹ l`: how a force `l` on the coordinates changes the acceleration.
+    #[inline]
+    pub fn apply_a_inv(&self, l: &[f64], out: &mut [f64]) {
+        match &self.operators {
+            Operators::Modal { a_inv, .. } => {
+                for i in 0..l.len() {
+                    out[i] = a_inv[i] * l[i];
+                }
+            }
+            Operators::Dense { a_inv, .. } => {
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = a_inv.row(i).iter().zip(l).map(|(a, v)| a * v).sum();
+                }
+            }
         }
     }
 
@@ -95,23 +205,60 @@ impl CentralDifference {
         }
     }
 
-    /// Kinetic plus strain energy `½ q̇ᵀq̇ + ½ qᵀΩ²q`.
+    /// Kinetic plus strain energy `½ q̇ᵀMq̇ + ½ qᵀKq`.
     #[inline]
-    pub fn modal_energy(&self) -> f64 {
-        let mut e = 0.0;
-        for i in 0..self.q.len() {
-            e += self.qd[i] * self.qd[i] + self.omega2[i] * self.q[i] * self.q[i];
+    pub fn energy(&self) -> f64 {
+        match &self.operators {
+            Operators::Modal { omega2, .. } => {
+                let mut e = 0.0;
+                for i in 0..self.q.len() {
+                    e += self.qd[i] * self.qd[i] + omega2[i] * self.q[i] * self.q[i];
+                }
+                0.5 * e
+            }
+            Operators::Dense {
+                mass, stiffness, ..
+            } => 0.5 * (quadratic(mass, &self.qd) + quadratic(stiffness, &self.q)),
         }
-        0.5 * e
     }
 
-    /// Power dissipated by modal damping, `q̇ᵀ C_m q̇`.
+    /// Power dissipated by damping, `q̇ᵀ C q̇`.
     #[inline]
     pub fn damping_power(&self) -> f64 {
-        self.qd
-            .iter()
-            .zip(&self.damping)
-            .map(|(v, c)| c * v * v)
-            .sum()
+        match &self.operators {
+            Operators::Modal { damping, .. } => {
+                self.qd.iter().zip(damping).map(|(v, c)| c * v * v).sum()
+            }
+            Operators::Dense { damping, .. } => quadratic(damping, &self.qd),
+        }
     }
+}
+
+/// `work = f − K q − C v`.
+fn residual(
+    f: &[f64],
+    k: &DMatrix<f64>,
+    q: &[f64],
+    c: &DMatrix<f64>,
+    v: &[f64],
+    work: &mut DVector<f64>,
+) {
+    for i in 0..f.len() {
+        let mut r = f[i];
+        for j in 0..f.len() {
+            r -= k[(i, j)] * q[j] + c[(i, j)] * v[j];
+        }
+        work[i] = r;
+    }
+}
+
+/// `xᵀ A x`.
+fn quadratic(a: &DMatrix<f64>, x: &[f64]) -> f64 {
+    let mut s = 0.0;
+    for i in 0..x.len() {
+        for j in 0..x.len() {
+            s += x[i] * a[(i, j)] * x[j];
+        }
+    }
+    s
 }

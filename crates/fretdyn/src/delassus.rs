@@ -66,16 +66,17 @@ impl TangentialProblem {
     }
 
     /// Declares that `contact` always has the tangent basis `tangents`: its rows, and its
-    /// blocks of `H` with the other fixed contacts, are computed now, once.
+    /// blocks of `H` with the other fixed contacts, are computed now, once. `apply_a_inv`
+    /// computes `A⁻¹ l` (see [`push_with`](Self::push_with)).
     pub fn fix_rows(
         &mut self,
         contact: usize,
         tangents: &[Vector3<f64>; 2],
         rows: &[f64],
-        a_inv: &[f64],
+        apply_a_inv: impl Fn(&[f64], &mut [f64]),
     ) {
         self.fixed[contact] = false;
-        self.compute_rows(contact, tangents, rows, a_inv);
+        self.compute_rows(contact, tangents, rows, apply_a_inv);
         self.fixed[contact] = true;
         let p = self.p;
         for other in 0..self.fixed.len() {
@@ -101,18 +102,16 @@ impl TangentialProblem {
         contact: usize,
         tangents: &[Vector3<f64>; 2],
         rows: &[f64],
-        a_inv: &[f64],
+        apply_a_inv: impl Fn(&[f64], &mut [f64]),
     ) {
         let p = self.p;
         for (a, t) in tangents.iter().enumerate() {
             let r = 2 * contact + a;
             let l = &mut self.l[r * p..(r + 1) * p];
-            let al = &mut self.al[r * p..(r + 1) * p];
             for i in 0..p {
-                let v = t.x * rows[i] + t.y * rows[p + i] + t.z * rows[2 * p + i];
-                l[i] = v;
-                al[i] = v * a_inv[i];
+                l[i] = t.x * rows[i] + t.y * rows[p + i] + t.z * rows[2 * p + i];
             }
+            apply_a_inv(l, &mut self.al[r * p..(r + 1) * p]);
         }
     }
 
@@ -147,12 +146,29 @@ impl TangentialProblem {
     }
 
     /// Adds a closed contact with its tangent basis, point rows (3 × p), and the diagonal of
-    /// `A⁻¹` (ignored for a contact whose rows were fixed); the contact's velocity terms enter
-    /// `b` when [`assemble`](Self::assemble) is called.
+    /// `A⁻¹` (modal coordinates); see [`push_with`](Self::push_with).
     #[inline]
     pub fn push(&mut self, slot: Slot, tangents: &[Vector3<f64>; 2], rows: &[f64], a_inv: &[f64]) {
+        self.push_with(slot, tangents, rows, |l, out| {
+            for i in 0..l.len() {
+                out[i] = a_inv[i] * l[i];
+            }
+        });
+    }
+
+    /// Adds a closed contact with its tangent basis and point rows (3 × p); `apply_a_inv(l, out)`
+    /// computes `out = A⁻¹ l` (ignored for a contact whose rows were fixed). The contact's
+    /// velocity terms enter `b` when [`assemble`](Self::assemble) is called.
+    #[inline]
+    pub fn push_with(
+        &mut self,
+        slot: Slot,
+        tangents: &[Vector3<f64>; 2],
+        rows: &[f64],
+        apply_a_inv: impl Fn(&[f64], &mut [f64]),
+    ) {
         if !self.fixed[slot.contact] {
-            self.compute_rows(slot.contact, tangents, rows, a_inv);
+            self.compute_rows(slot.contact, tangents, rows, apply_a_inv);
         }
         self.slots.push(slot);
     }

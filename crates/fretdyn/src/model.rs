@@ -15,11 +15,39 @@ pub struct InitialState {
     pub qdot: Vec<f64>,
 }
 
+/// Mass, damping and stiffness matrices of physical coordinates (symmetric, `M` positive
+/// definite), for the physical-coordinates reference solver.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhysicalMatrices {
+    /// Mass matrix `M`.
+    pub mass: nalgebra::DMatrix<f64>,
+    /// Damping matrix `C`.
+    pub damping: nalgebra::DMatrix<f64>,
+    /// Stiffness matrix `K`.
+    pub stiffness: nalgebra::DMatrix<f64>,
+}
+
+/// What the generalized coordinates `q` of a model are.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum Coordinates {
+    /// Modal coordinates of a mass-normalised basis: `M = I`, `K = Ω²`,
+    /// `C = diag(2 ξ_i ω_i)` (THEORY §1). The normal case.
+    #[default]
+    Modal,
+    /// Physical degrees of freedom with their matrices: the same central differences and
+    /// contacts on `M q̈ + C q̇ + K q = f`, used to prove that the modal solution is exact when
+    /// every mode is kept. The "basis" then holds, for each point, the 3 × n rows that pick
+    /// its displacement out of `q`; its frequencies and damping ratios are not used.
+    Physical(Box<PhysicalMatrices>),
+}
+
 /// A structure on its modal basis with its contacts and loads.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
     /// Modal basis with the rows of every point used.
     pub basis: ModalBasis,
+    /// Modal (the normal case) or physical coordinates.
+    pub coordinates: Coordinates,
     /// Contacts.
     pub contacts: Vec<Contact>,
     /// Point loads.
@@ -34,6 +62,7 @@ impl Model {
         let p = basis.modes();
         Self {
             basis,
+            coordinates: Coordinates::Modal,
             contacts: Vec::new(),
             loads: Vec::new(),
             initial: InitialState {
@@ -43,10 +72,43 @@ impl Model {
         }
     }
 
+    /// A model in physical coordinates: `points` give, for each named point, the 3 × n rows
+    /// that pick its displacement out of the n degrees of freedom.
+    pub fn physical(matrices: PhysicalMatrices, points: Vec<crate::modal::Point>) -> Self {
+        let n = matrices.mass.nrows();
+        let mut model = Self::new(ModalBasis {
+            omega: vec![0.0; n],
+            damping_ratio: vec![0.0; n],
+            points,
+        });
+        model.coordinates = Coordinates::Physical(Box::new(matrices));
+        model
+    }
+
     /// Checks the basis and that every index and vector length is consistent.
     pub fn validate(&self) -> Result<()> {
         self.basis.validate("structure")?;
         let p = self.basis.modes();
+        if let Coordinates::Physical(m) = &self.coordinates {
+            for (name, a) in [
+                ("mass", &m.mass),
+                ("damping", &m.damping),
+                ("stiffness", &m.stiffness),
+            ] {
+                if a.nrows() != p || a.ncols() != p || a.iter().any(|v| !v.is_finite()) {
+                    return Err(Error::invalid(
+                        format!("structure.{name}"),
+                        format!("must be a finite {p} × {p} matrix"),
+                    ));
+                }
+            }
+            if m.mass.clone().cholesky().is_none() {
+                return Err(Error::invalid(
+                    "structure.mass",
+                    "the mass matrix is not positive definite",
+                ));
+            }
+        }
         let np = self.basis.points.len();
         for (k, c) in self.contacts.iter().enumerate() {
             if c.point >= np {

@@ -305,7 +305,7 @@ impl<'m> Simulation<'m> {
     fn new(model: &'m Model, settings: &'m RunSettings, _stable_dt: f64) -> Self {
         let p = model.basis.modes();
         let nc = model.contacts.len();
-        let mut cd = CentralDifference::new(&model.basis, settings.dt);
+        let mut cd = CentralDifference::new(model, settings.dt);
         cd.q.copy_from_slice(&model.initial.q);
         cd.qd.copy_from_slice(&model.initial.qdot);
         let mut load_rows = vec![0.0; p * model.loads.len()];
@@ -322,11 +322,11 @@ impl<'m> Simulation<'m> {
                 contacts: vec![PenaltyContact::default(); nc],
             },
             TangentialMethod::GaussSeidel(s) => {
-                Tangential::lagrange(model, &cd.a_inv, settings, LagrangeSolver::GaussSeidel(s))
+                Tangential::lagrange(model, &cd, settings, LagrangeSolver::GaussSeidel(s))
             }
             TangentialMethod::ActiveSet(s) => Tangential::lagrange(
                 model,
-                &cd.a_inv,
+                &cd,
                 settings,
                 LagrangeSolver::ActiveSet(Box::new(ActiveSet::new(s, nc))),
             ),
@@ -523,7 +523,8 @@ impl<'m> Simulation<'m> {
         problem.clear();
         for (k, (c, state)) in self.model.contacts.iter().zip(&self.contacts).enumerate() {
             if state.closed {
-                problem.push(
+                let cd = &self.cd;
+                problem.push_with(
                     Slot {
                         contact: k,
                         s_static: c.friction.mu_static * state.normal_force,
@@ -531,7 +532,7 @@ impl<'m> Simulation<'m> {
                     },
                     &state.frame.tangents,
                     &self.model.basis.points[c.point].rows,
-                    &self.cd.a_inv,
+                    |l, out| cd.apply_a_inv(l, out),
                 );
             }
         }
@@ -612,7 +613,7 @@ impl<'m> Simulation<'m> {
 
     /// Energy `E` and the powers `[external, modal damping, contact damping, tangential]`.
     fn energy_and_powers(&self) -> (f64, [f64; 4]) {
-        let mut e = self.cd.modal_energy();
+        let mut e = self.cd.energy();
         let mut contact_damping = 0.0;
         let mut tangential = 0.0;
         for (c, s) in self.model.contacts.iter().zip(&self.contacts) {
@@ -683,7 +684,7 @@ impl<'m> Simulation<'m> {
 impl Tangential {
     fn lagrange(
         model: &Model,
-        a_inv: &[f64],
+        cd: &CentralDifference,
         settings: &RunSettings,
         solver: LagrangeSolver,
     ) -> Self {
@@ -691,7 +692,9 @@ impl Tangential {
         let mut problem = TangentialProblem::new(model.basis.modes(), nc);
         for (k, c) in model.contacts.iter().enumerate() {
             if let Some(t) = c.obstacle.fixed_tangents() {
-                problem.fix_rows(k, &t, &model.basis.points[c.point].rows, a_inv);
+                problem.fix_rows(k, &t, &model.basis.points[c.point].rows, |l, out| {
+                    cd.apply_a_inv(l, out)
+                });
             }
         }
         Tangential::Lagrange {

@@ -8,17 +8,24 @@
 
 use nalgebra::{DMatrix, Vector3};
 
-use crate::model::Model;
+use crate::model::{Coordinates, Model};
 use crate::tangential::TangentialMethod;
 
-/// The stable time step of `model` with `method`, s.
+/// The stable time step of `model` with `method`, s. In physical coordinates the
+/// eigenvalues are those of `K φ = ω² M φ` (and `C φ = c M φ`).
 pub fn stable_time_step(model: &Model, method: &TangentialMethod) -> f64 {
     let p = model.basis.modes();
-    let mut k = DMatrix::<f64>::zeros(p, p);
-    let mut c = DMatrix::<f64>::zeros(p, p);
-    for (i, w) in model.basis.omega.iter().enumerate() {
-        k[(i, i)] = w * w;
-    }
+    let (mut k, mut c) = match &model.coordinates {
+        Coordinates::Modal => {
+            let mut k = DMatrix::<f64>::zeros(p, p);
+            for (i, w) in model.basis.omega.iter().enumerate() {
+                k[(i, i)] = w * w;
+            }
+            (k, DMatrix::<f64>::zeros(p, p))
+        }
+        // structural damping acts through A (implicitly): only contact damping is explicit
+        Coordinates::Physical(m) => (m.stiffness.clone(), DMatrix::<f64>::zeros(p, p)),
+    };
     let (kt, ct) = match method {
         TangentialMethod::Penalty(s) => (s.stiffness, s.damping),
         _ => (0.0, 0.0),
@@ -33,8 +40,21 @@ pub fn stable_time_step(model: &Model, method: &TangentialMethod) -> f64 {
             add_direction(&mut c, rows, ta, ct);
         }
     }
-    let w2 = largest_eigenvalue(k);
-    let cmax = largest_eigenvalue(c);
+    let (w2, cmax) = match &model.coordinates {
+        Coordinates::Modal => (largest_eigenvalue(k), largest_eigenvalue(c)),
+        Coordinates::Physical(m) => match m.mass.clone().cholesky() {
+            Some(chol) => {
+                // L⁻¹ X L⁻ᵀ has the eigenvalues of X φ = λ M φ
+                let scaled = |x: DMatrix<f64>| {
+                    let y = chol.l().solve_lower_triangular(&x).unwrap_or(x);
+                    let z = chol.l().solve_lower_triangular(&y.transpose()).unwrap_or(y);
+                    largest_eigenvalue((&z + z.transpose()) * 0.5)
+                };
+                (scaled(k), scaled(c))
+            }
+            None => return 0.0,
+        },
+    };
     if w2 <= 0.0 {
         return f64::INFINITY;
     }
