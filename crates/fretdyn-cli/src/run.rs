@@ -21,6 +21,9 @@ pub fn main(
         Some(path) => {
             let case = Case::from_file(path)
                 .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+            for w in &case.warnings {
+                eprintln!("warning: {w}");
+            }
             let dir = output.unwrap_or_else(|| default_dir(&case.title, path));
             run_and_write(&case, &path.display().to_string(), &dir, quiet, plots)?;
             Ok(())
@@ -87,7 +90,7 @@ pub fn write_outputs(
     })?;
     let io = |e: fretdyn::Error| Failure::failed(e.to_string());
     fretdyn::output::write_results_npz(dir, results).map_err(io)?;
-    let summary = fretdyn::output::summary(&case.title, &case.echo, results);
+    let summary = fretdyn::output::summary(case, results);
     fretdyn::output::write_summary(dir, &summary).map_err(io)?;
     if plots && !case.model.contacts.is_empty() {
         plot_contact_forces(&dir.join("contact_forces.png"), case, results)

@@ -29,6 +29,8 @@ pub struct Case {
     pub settings: RunSettings,
     /// The case as read, echoed in `summary.json`.
     pub echo: serde_json::Value,
+    /// Accepted but doubtful input (e.g. an approximately mass-normalised basis).
+    pub warnings: Vec<String>,
 }
 
 impl Case {
@@ -52,12 +54,14 @@ impl Case {
         let echo_value: toml::Value = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
         let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
         let title = file.title.clone().unwrap_or_default();
-        let (model, settings) = file.build(base)?;
+        let mut warnings = Vec::new();
+        let (model, settings) = file.build(base, &mut warnings)?;
         Ok(Self {
             title,
             model,
             settings,
             echo,
+            warnings,
         })
     }
 
@@ -68,6 +72,7 @@ impl Case {
             model,
             settings,
             echo: serde_json::Value::Null,
+            warnings: Vec::new(),
         }
     }
 }
@@ -365,8 +370,8 @@ fn v3(a: [f64; 3]) -> Vector3<f64> {
 }
 
 impl CaseFile {
-    fn build(self, base: &Path) -> Result<(Model, RunSettings)> {
-        let basis = self.structure.build(base)?;
+    fn build(self, base: &Path, warnings: &mut Vec<String>) -> Result<(Model, RunSettings)> {
+        let basis = self.structure.build(base, warnings)?;
         basis.validate("structure")?;
         let mut model = Model::new(basis);
         let point = |name: &str, field: String, model: &Model| {
@@ -534,7 +539,7 @@ impl GaussSeidelInput {
 }
 
 impl StructureSection {
-    fn build(&self, base: &Path) -> Result<ModalBasis> {
+    fn build(&self, base: &Path, warnings: &mut Vec<String>) -> Result<ModalBasis> {
         match self {
             StructureSection::PointMass {
                 mass,
@@ -572,7 +577,11 @@ impl StructureSection {
                 points,
             } => {
                 let mut basis = match (file, frequencies_hz) {
-                    (Some(f), None) => crate::output::read_basis_npz(&base.join(f))?,
+                    (Some(f), None) => {
+                        let file = crate::output::read_basis_npz(&base.join(f))?;
+                        warnings.extend(file.warnings);
+                        file.basis
+                    }
                     (None, Some(freq)) => ModalBasis {
                         omega: freq.iter().map(|f| f * std::f64::consts::TAU).collect(),
                         damping_ratio: vec![0.0; freq.len()],

@@ -54,11 +54,12 @@ pub fn write_results_npz(dir: &Path, results: &RunResults) -> Result<PathBuf> {
 
 /// The JSON summary of a run: the case echoed, per-contact statistics, energy balance, solver
 /// statistics, steps, wall time and steps/s.
-pub fn summary(title: &str, case: &serde_json::Value, results: &RunResults) -> serde_json::Value {
+pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
     let s = &results.solver;
     json!({
         "fretdyn_version": env!("CARGO_PKG_VERSION"),
-        "title": title,
+        "title": case.title,
+        "warnings": case.warnings,
         "termination": results.termination,
         "time": {
             "dt": results.dt,
@@ -78,7 +79,7 @@ pub fn summary(title: &str, case: &serde_json::Value, results: &RunResults) -> s
             "wall_time_s": results.wall_time,
             "steps_per_second": results.steps_per_second(),
         },
-        "case": case,
+        "case": case.echo,
     })
 }
 
@@ -104,7 +105,7 @@ fn write_atomically(path: &Path, write: impl FnOnce(File) -> std::io::Result<()>
 }
 
 /// Reads a modal basis `.npz` (keys in the module documentation).
-pub fn read_basis_npz(path: &Path) -> Result<ModalBasis> {
+pub fn read_basis_npz(path: &Path) -> Result<BasisFile> {
     let npz_err = |message: String| Error::Npz {
         path: path.to_path_buf(),
         message,
@@ -177,7 +178,59 @@ pub fn read_basis_npz(path: &Path) -> Result<ModalBasis> {
         damping_ratio,
         points,
     };
-    basis.validate(&path.display().to_string()).map(|_| basis)
+    basis.validate(&path.display().to_string())?;
+    let mut warnings = Vec::new();
+    let has = |k: &str| names.iter().any(|n| n == k);
+    if has("mass_matrix") || has("shapes") {
+        let m: Array2<f64> = npz
+            .by_name("mass_matrix")
+            .map_err(|e| npz_err(format!("'mass_matrix' (n, n) must come with 'shapes': {e}")))?;
+        let phi: Array2<f64> = npz
+            .by_name("shapes")
+            .map_err(|e| npz_err(format!("'shapes' (n, p) must come with 'mass_matrix': {e}")))?;
+        let n = m.nrows();
+        if m.shape() != [n, n] || phi.shape() != [n, p] {
+            return Err(npz_err(format!(
+                "'mass_matrix' has shape {:?} and 'shapes' {:?}: expected (n, n) and (n, {p})",
+                m.shape(),
+                phi.shape()
+            )));
+        }
+        let gram = phi.t().dot(&m).dot(&phi);
+        let (mut worst, mut at) = (0.0f64, (0, 0));
+        for ((i, j), v) in gram.indexed_iter() {
+            let d = (v - if i == j { 1.0 } else { 0.0 }).abs();
+            if !(d <= worst) {
+                worst = d;
+                at = (i, j);
+            }
+        }
+        if !(worst <= 1e-3) {
+            return Err(npz_err(format!(
+                "the modes are not mass-normalised: |ΦᵀMΦ − I| = {worst:.3e} at modes ({}, {}); normalise each mode to φᵀMφ = 1 and check they are M-orthogonal",
+                at.0 + 1,
+                at.1 + 1
+            )));
+        }
+        if worst > 1e-9 {
+            warnings.push(format!(
+                "{}: the modes are only approximately mass-normalised: worst |ΦᵀMΦ − I| = {worst:.3e} at modes ({}, {})",
+                path.display(),
+                at.0 + 1,
+                at.1 + 1
+            ));
+        }
+    }
+    Ok(BasisFile { basis, warnings })
+}
+
+/// A modal basis read from a `.npz`, with what the reader noticed.
+#[derive(Debug, Clone)]
+pub struct BasisFile {
+    /// The basis.
+    pub basis: ModalBasis,
+    /// Accepted but doubtful things (an approximately mass-normalised basis).
+    pub warnings: Vec<String>,
 }
 
 /// Writes a modal basis as `.npz` (keys in the module documentation).

@@ -397,7 +397,7 @@ fn modal_basis_npz_round_trip() {
     basis.points[1].coords = nalgebra::Vector3::new(1.1, -0.25, 3.5);
     let path = dir.0.join("basis.npz");
     fretdyn::output::write_basis_npz(&path, &basis).unwrap();
-    let back = fretdyn::output::read_basis_npz(&path).unwrap();
+    let back = fretdyn::output::read_basis_npz(&path).unwrap().basis;
     assert_eq!(
         back.points, basis.points,
         "rows and coords are stored as float64"
@@ -442,6 +442,58 @@ fn npz_rows_of_the_wrong_shape_are_refused_with_the_expected_shape() {
             assert_eq!(p, path);
             assert!(message.contains("rows_A"), "{message}");
             assert!(message.contains("(3, 3)"), "{message}");
+        }
+        other => panic!("expected Error::Npz, got {other:?}"),
+    }
+}
+
+/// A basis exported with its mass matrix and full shapes is checked for `Φᵀ M Φ = I`:
+/// exact → accepted silently; off by 1e-6 → accepted with a warning giving the worst
+/// deviation; off by 1e-2 → refused.
+#[test]
+fn npz_mass_normalisation_is_checked_when_the_mass_matrix_is_given() {
+    use ndarray::{Array1, Array2};
+    // 2 DOFs, M = diag(4, 9): mass-normalised modes are e1/2 and e2/3
+    let write = |name: &str, scale: f64| {
+        let dir = TempDir::new(name);
+        let path = dir.0.join("basis.npz");
+        let file = std::fs::File::create(&path).unwrap();
+        let mut npz = ndarray_npy::NpzWriter::new(file);
+        npz.add_array("frequencies_hz", &Array1::from(vec![1.0, 2.0]))
+            .unwrap();
+        npz.add_array(
+            "mass_matrix",
+            &Array2::from_shape_vec((2, 2), vec![4.0, 0.0, 0.0, 9.0]).unwrap(),
+        )
+        .unwrap();
+        let shapes =
+            Array2::from_shape_vec((2, 2), vec![0.5 * scale, 0.0, 0.0, 1.0 / 3.0]).unwrap();
+        npz.add_array("shapes", &shapes).unwrap();
+        npz.add_array(
+            "rows_A",
+            &Array2::from_shape_vec((3, 2), vec![0.5 * scale, 0.0, 0.0, 1.0 / 3.0, 0.0, 0.0])
+                .unwrap(),
+        )
+        .unwrap();
+        npz.finish().unwrap();
+        let result = fretdyn::output::read_basis_npz(&path);
+        (dir, result)
+    };
+    let (_d, exact) = write("exact", 1.0);
+    assert!(exact.unwrap().warnings.is_empty());
+    // φ₁ᵀ M φ₁ = (1 + 5e-7)² ≈ 1 + 1e-6
+    let (_d, approx) = write("approx", 1.0 + 5e-7);
+    let w = approx.unwrap().warnings;
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains("1.000e-6") && w[0].contains("modes (1, 1)"),
+        "{w:?}"
+    );
+    let (_d, bad) = write("bad", 1.01);
+    match bad {
+        Err(Error::Npz { message, .. }) => {
+            assert!(message.contains("not mass-normalised"), "{message}");
+            assert!(message.contains("2.010e-2"), "{message}");
         }
         other => panic!("expected Error::Npz, got {other:?}"),
     }
