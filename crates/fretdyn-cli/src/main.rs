@@ -1,6 +1,7 @@
 //! The `fretdyn` command: run case files, verify against the analytic solutions, benchmark.
 
 mod bench;
+mod modes;
 mod plot;
 mod progress;
 mod run;
@@ -46,6 +47,18 @@ enum Command {
         #[arg(short, long)]
         quiet: bool,
     },
+    /// Print the modal basis of a case (frequency table), write it as .npz and, for a tube,
+    /// a picture of its first mode shapes.
+    Modes {
+        /// Case file (TOML).
+        case: PathBuf,
+        /// Output folder [default: fretdyn_results/<case name>_modes].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Mode shapes drawn.
+        #[arg(long, default_value_t = 4)]
+        shown: usize,
+    },
     /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube.
     Bench {
         /// Steps per run of the synthetic tube (V1 runs its 4000 steps, 20 × repeat times).
@@ -78,6 +91,11 @@ fn main() -> ExitCode {
             no_plots,
         } => run::main(case.as_deref(), output, quiet, !no_plots),
         Command::Verify { output, quiet } => verify::main(&output, quiet),
+        Command::Modes {
+            case,
+            output,
+            shown,
+        } => modes::main(&case, output, shown),
         Command::Bench {
             steps,
             repeat,

@@ -6,7 +6,11 @@ use std::path::Path;
 use nalgebra::Vector3;
 use serde::Deserialize;
 
+use crate::beam::{
+    BeamModel, Fluid, Material, Mesh, Restraint, Theory, Tube, TubeSection, clamped, pinned,
+};
 use crate::contact::{Contact, NormalLaw};
+use crate::eigen::ModeSelection;
 use crate::error::{Error, Result};
 use crate::friction::{Coulomb, LocalSolve};
 use crate::load::{PointLoad, TimeHistory};
@@ -17,6 +21,7 @@ use crate::simulation::RunSettings;
 use crate::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
+use crate::tube::{Damping, NamedPoint, TubeBasis, TubeStructure, node_at};
 
 /// A parsed, validated case.
 #[derive(Debug, Clone)]
@@ -31,6 +36,8 @@ pub struct Case {
     pub echo: serde_json::Value,
     /// Accepted but doubtful input (e.g. an approximately mass-normalised basis).
     pub warnings: Vec<String>,
+    /// For a `type = "tube"` structure: its finite-element model and modes.
+    pub tube: Option<Box<TubeModel>>,
 }
 
 impl Case {
@@ -55,12 +62,13 @@ impl Case {
         let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
         let title = file.title.clone().unwrap_or_default();
         let mut warnings = Vec::new();
-        let (model, settings) = file.build(base, &mut warnings)?;
+        let (model, settings, tube) = file.build(base, &mut warnings)?;
         Ok(Self {
             title,
             model,
             settings,
             echo,
+            tube,
             warnings,
         })
     }
@@ -73,6 +81,7 @@ impl Case {
             settings,
             echo: serde_json::Value::Null,
             warnings: Vec::new(),
+            tube: None,
         }
     }
 }
@@ -135,6 +144,7 @@ enum StructureSection {
         #[serde(default)]
         points: Vec<PointInput>,
     },
+    Tube(Box<TubeInput>),
     PinnedBeam {
         length: f64,
         bending_stiffness: f64,
@@ -148,6 +158,84 @@ enum StructureSection {
         damping_ratio: f64,
         points: Vec<StationInput>,
     },
+}
+
+/// `type = "tube"`: a beam finite-element tube (see `examples/tube_clamped_one_support.toml`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TubeInput {
+    outer_diameter: f64,
+    wall_thickness: f64,
+    young_modulus: f64,
+    poisson_ratio: f64,
+    density: f64,
+    #[serde(default)]
+    inner_fluid_density: f64,
+    #[serde(default)]
+    outer_fluid_density: f64,
+    #[serde(default)]
+    added_mass_coefficient: f64,
+    #[serde(default)]
+    theory: TheoryName,
+    mesh_size: f64,
+    path: Option<Vec<[f64; 3]>>,
+    u_bend: Option<UBendInput>,
+    modes: Option<usize>,
+    max_frequency_hz: Option<f64>,
+    damping_ratio: Option<DampingInput>,
+    rayleigh: Option<RayleighInput>,
+    #[serde(default)]
+    supports: Vec<SupportInput>,
+    #[serde(default)]
+    points: Vec<TubePointInput>,
+}
+
+#[derive(Debug, Default, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+enum TheoryName {
+    #[default]
+    EulerBernoulli,
+    Timoshenko,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UBendInput {
+    leg_length: f64,
+    radius: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RayleighInput {
+    alpha: f64,
+    beta: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SupportInput {
+    at: [f64; 3],
+    #[serde(rename = "type")]
+    kind: SupportKind,
+    stiffness: Option<[f64; 6]>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+enum SupportKind {
+    Clamped,
+    Pinned,
+    Springs,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TubePointInput {
+    name: String,
+    at: [f64; 3],
+    #[serde(default)]
+    offset: [f64; 3],
 }
 
 fn default_point_name() -> String {
@@ -369,9 +457,160 @@ fn v3(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
 }
 
+impl TubeInput {
+    fn structure(&self) -> Result<TubeStructure> {
+        let tube = Tube {
+            section: TubeSection {
+                outer_diameter: self.outer_diameter,
+                wall_thickness: self.wall_thickness,
+            },
+            material: Material {
+                young_modulus: self.young_modulus,
+                poisson_ratio: self.poisson_ratio,
+                density: self.density,
+            },
+            fluid: Fluid {
+                inner_density: self.inner_fluid_density,
+                outer_density: self.outer_fluid_density,
+                added_mass_coefficient: self.added_mass_coefficient,
+            },
+            theory: match self.theory {
+                TheoryName::EulerBernoulli => Theory::EulerBernoulli,
+                TheoryName::Timoshenko => Theory::Timoshenko,
+            },
+        };
+        tube.validate("structure")?;
+        if !(self.mesh_size.is_finite() && self.mesh_size > 0.0) {
+            return Err(Error::invalid(
+                "structure.mesh_size",
+                format!(
+                    "must be a positive element length in m (got {})",
+                    self.mesh_size
+                ),
+            ));
+        }
+        let mesh = match (&self.path, &self.u_bend) {
+            (Some(path), None) => {
+                let vertices: Vec<Vector3<f64>> = path.iter().map(|v| v3(*v)).collect();
+                Mesh::polyline(&vertices, self.mesh_size)?
+            }
+            (None, Some(u)) => Mesh::u_bend(u.leg_length, u.radius, self.mesh_size)?,
+            _ => {
+                return Err(Error::invalid(
+                    "structure",
+                    "a tube needs either path = [[x, y, z], …] (straight segments) or u_bend = { leg_length, radius }",
+                ));
+            }
+        };
+        let tolerance = 1e-3 * self.mesh_size;
+        let mut restraints = Vec::new();
+        for (k, sup) in self.supports.iter().enumerate() {
+            let field = format!("structure.supports[{k}]");
+            let node = node_at(&mesh, &v3(sup.at), tolerance, &format!("{field}.at"))?;
+            let r = match (sup.kind, sup.stiffness) {
+                (SupportKind::Clamped, None) => clamped(),
+                (SupportKind::Pinned, None) => pinned(),
+                (SupportKind::Springs, Some(k)) => {
+                    if let Some(v) = k.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+                        return Err(Error::invalid(
+                            format!("{field}.stiffness"),
+                            format!("spring stiffnesses must be ≥ 0 (got {v})"),
+                        ));
+                    }
+                    k.map(|v| {
+                        if v > 0.0 {
+                            Restraint::Spring(v)
+                        } else {
+                            Restraint::Free
+                        }
+                    })
+                }
+                (SupportKind::Springs, None) => {
+                    return Err(Error::invalid(
+                        format!("{field}.stiffness"),
+                        "type = \"springs\" needs stiffness = [kx, ky, kz, krx, kry, krz] (N/m, N·m/rad; 0 = free)",
+                    ));
+                }
+                (_, Some(_)) => {
+                    return Err(Error::invalid(
+                        format!("{field}.stiffness"),
+                        "only type = \"springs\" takes stiffnesses",
+                    ));
+                }
+            };
+            restraints.push((node, r));
+        }
+        let mut points = Vec::new();
+        for (k, pt) in self.points.iter().enumerate() {
+            let field = format!("structure.points[{k}]");
+            let node = node_at(&mesh, &v3(pt.at), tolerance, &format!("{field}.at"))?;
+            let offset = v3(pt.offset);
+            if offset.iter().any(|v| !v.is_finite()) {
+                return Err(Error::invalid(
+                    format!("{field}.offset"),
+                    "must be 3 finite numbers",
+                ));
+            }
+            points.push(NamedPoint {
+                name: pt.name.clone(),
+                node,
+                offset,
+            });
+        }
+        let selection = match (self.modes, self.max_frequency_hz) {
+            (Some(n), None) if n > 0 => ModeSelection::Count(n),
+            (None, Some(f)) if f.is_finite() && f > 0.0 => ModeSelection::BelowHz(f),
+            _ => {
+                return Err(Error::invalid(
+                    "structure.modes",
+                    "give either modes = N (the N lowest modes) or max_frequency_hz = F (every mode below F), N and F positive",
+                ));
+            }
+        };
+        let damping = match (&self.damping_ratio, &self.rayleigh) {
+            (Some(DampingInput::Constant(x)), None) => Damping::Constant(*x),
+            (Some(DampingInput::PerMode(v)), None) => Damping::PerMode(v.clone()),
+            (None, Some(r)) => Damping::Rayleigh {
+                alpha: r.alpha,
+                beta: r.beta,
+            },
+            (None, None) => Damping::Constant(0.0),
+            (Some(_), Some(_)) => {
+                return Err(Error::invalid(
+                    "structure.rayleigh",
+                    "give either damping_ratio or rayleigh = { alpha, beta }, not both",
+                ));
+            }
+        };
+        Ok(TubeStructure {
+            beam: BeamModel {
+                mesh,
+                tube,
+                restraints,
+            },
+            points,
+            selection,
+            damping,
+        })
+    }
+}
+
+/// A tube case keeps its finite-element model and full modes (for `fretdyn modes`).
+#[derive(Debug, Clone)]
+pub struct TubeModel {
+    /// The structure as described in the case.
+    pub structure: TubeStructure,
+    /// Its modes.
+    pub basis: TubeBasis,
+}
+
 impl CaseFile {
-    fn build(self, base: &Path, warnings: &mut Vec<String>) -> Result<(Model, RunSettings)> {
-        let basis = self.structure.build(base, warnings)?;
+    fn build(
+        self,
+        base: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<(Model, RunSettings, Option<Box<TubeModel>>)> {
+        let (basis, tube) = self.structure.build(base, warnings)?;
         basis.validate("structure")?;
         let mut model = Model::new(basis);
         let point = |name: &str, field: String, model: &Model| {
@@ -520,7 +759,7 @@ impl CaseFile {
             output_every: self.output.every,
         };
         settings.validate()?;
-        Ok((model, settings))
+        Ok((model, settings, tube))
     }
 }
 
@@ -539,8 +778,25 @@ impl GaussSeidelInput {
 }
 
 impl StructureSection {
-    fn build(&self, base: &Path, warnings: &mut Vec<String>) -> Result<ModalBasis> {
+    fn build(
+        &self,
+        base: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<(ModalBasis, Option<Box<TubeModel>>)> {
+        if let StructureSection::Tube(t) = self {
+            let structure = t.structure()?;
+            let basis = structure.modal_basis()?;
+            return Ok((
+                basis.basis.clone(),
+                Some(Box::new(TubeModel { structure, basis })),
+            ));
+        }
+        self.build_basis(base, warnings).map(|b| (b, None))
+    }
+
+    fn build_basis(&self, base: &Path, warnings: &mut Vec<String>) -> Result<ModalBasis> {
         match self {
+            StructureSection::Tube(_) => unreachable!("handled by build"),
             StructureSection::PointMass {
                 mass,
                 point,

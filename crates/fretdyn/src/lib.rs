@@ -7,7 +7,8 @@
 //! docs); section numbers in the doc comments refer to it.
 //!
 //! Data flow, one module per concept:
-//! [`case`] (TOML) → [`model`] ([`modal`] basis, [`contact`]s with their [`obstacle`] and
+//! [`case`] (TOML; a [`tube`] is meshed with [`beam`] elements and reduced by [`eigen`]) →
+//! [`model`] ([`modal`] basis, [`contact`]s with their [`obstacle`] and
 //! [`friction`], [`load`]s) → [`simulation`] ([`central_difference`] steps, normal penalty,
 //! [`tangential`] methods on the [`delassus`] problem) → [`recorder`] and [`statistics`] →
 //! [`output`] (`results.npz`, `summary.json`).
@@ -22,11 +23,13 @@
 // Index loops mirror the equations of THEORY.md; `!(x > y)` is deliberate: it is true for NaN.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod beam;
 pub mod benchmark;
 pub mod case;
 pub mod central_difference;
 pub mod contact;
 pub mod delassus;
+pub mod eigen;
 pub mod error;
 pub mod friction;
 pub mod load;
@@ -39,6 +42,7 @@ pub mod simulation;
 pub mod stability;
 pub mod statistics;
 pub mod tangential;
+pub mod tube;
 pub mod verification;
 
 pub use error::{Error, Result};

@@ -1,0 +1,184 @@
+//! A tube as engineers describe it — section, material, fluids, path, supports, named points —
+//! turned into the modal basis the time integrator uses (and, for the tests, into the
+//! physical-coordinates model of the same finite elements).
+//!
+//! The beam finite elements are in [`crate::beam`], the eigen solver in [`crate::eigen`]. A
+//! named point sits at a node; with an `offset` (from the tube axis to a point of its outer
+//! surface, where it touches a support) its rows include the rotations:
+//! `u_surface = u + θ × r`.
+
+use nalgebra::{DMatrix, Vector3};
+
+use crate::beam::{Assembled, BeamModel, Dof, Mesh};
+use crate::eigen::{ModeSelection, Modes, lowest_modes};
+use crate::error::{Error, Result};
+use crate::modal::{ModalBasis, Point};
+use crate::model::{Model, PhysicalMatrices};
+
+/// A named point of the tube: a node, and an offset from the axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedPoint {
+    /// Name used by contacts, loads and outputs.
+    pub name: String,
+    /// Node index in the mesh.
+    pub node: usize,
+    /// Offset from the node (on the axis) to the point, m.
+    pub offset: Vector3<f64>,
+}
+
+/// Modal damping of the basis.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Damping {
+    /// The same ratio ξ for every mode.
+    Constant(f64),
+    /// One ratio per mode (as many as modes kept).
+    PerMode(Vec<f64>),
+    /// Rayleigh `C = α M + β K`: `ξ_i = α/(2ω_i) + β ω_i/2`.
+    Rayleigh { alpha: f64, beta: f64 },
+}
+
+/// A tube finite-element model with its named points, mode selection and damping.
+#[derive(Debug, Clone)]
+pub struct TubeStructure {
+    /// Mesh, tube properties and restraints.
+    pub beam: BeamModel,
+    /// Named points.
+    pub points: Vec<NamedPoint>,
+    /// Which modes to keep.
+    pub selection: ModeSelection,
+    /// Modal damping.
+    pub damping: Damping,
+}
+
+/// The modal basis of a tube, with what was computed to get it.
+#[derive(Debug, Clone)]
+pub struct TubeBasis {
+    /// The basis restricted to the named points (what the time integrator uses).
+    pub basis: ModalBasis,
+    /// Reduced mass and stiffness matrices.
+    pub assembled: Assembled,
+    /// Every kept mode at every free DOF.
+    pub modes: Modes,
+}
+
+impl TubeStructure {
+    /// Assembles, computes the modes and extracts the rows of the named points.
+    pub fn modal_basis(&self) -> Result<TubeBasis> {
+        let assembled = self.beam.assemble()?;
+        let modes = lowest_modes(&assembled.mass, &assembled.stiffness, self.selection)?;
+        let p = modes.omega.len();
+        let damping_ratio = match &self.damping {
+            Damping::Constant(x) => vec![*x; p],
+            Damping::PerMode(v) => {
+                if v.len() < p {
+                    return Err(Error::invalid(
+                        "structure.damping_ratio",
+                        format!(
+                            "has {} values for {p} modes kept: give one per mode",
+                            v.len()
+                        ),
+                    ));
+                }
+                v[..p].to_vec()
+            }
+            Damping::Rayleigh { alpha, beta } => modes
+                .omega
+                .iter()
+                .map(|w| {
+                    if *w > 0.0 {
+                        0.5 * (alpha / w + beta * w)
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
+        };
+        let points = self
+            .points
+            .iter()
+            .map(|pt| Point {
+                name: pt.name.clone(),
+                coords: self.beam.mesh.nodes[pt.node] + pt.offset,
+                rows: point_rows(&assembled, &modes.shapes, pt),
+            })
+            .collect();
+        Ok(TubeBasis {
+            basis: ModalBasis {
+                omega: modes.omega.clone(),
+                damping_ratio,
+                points,
+            },
+            assembled,
+            modes,
+        })
+    }
+
+    /// The same finite elements in physical coordinates with Rayleigh damping
+    /// `C = α M + β K` — the reference solver of the tests (small models only: dense).
+    pub fn physical_model(&self, alpha: f64, beta: f64) -> Result<Model> {
+        let assembled = self.beam.assemble()?;
+        let n = assembled.mass.nrows();
+        let identity = DMatrix::<f64>::identity(n, n);
+        let points = self
+            .points
+            .iter()
+            .map(|pt| Point {
+                name: pt.name.clone(),
+                coords: self.beam.mesh.nodes[pt.node] + pt.offset,
+                rows: point_rows(&assembled, &identity, pt),
+            })
+            .collect();
+        let damping = &assembled.mass * alpha + &assembled.stiffness * beta;
+        Ok(Model::physical(
+            PhysicalMatrices {
+                mass: assembled.mass,
+                damping,
+                stiffness: assembled.stiffness,
+            },
+            points,
+        ))
+    }
+}
+
+/// Rows (3 × p) of a named point from shapes (n × p) over the reduced DOFs:
+/// `u + θ × r` with `r` the point's offset; a restrained DOF contributes nothing.
+fn point_rows(assembled: &Assembled, shapes: &DMatrix<f64>, pt: &NamedPoint) -> Vec<f64> {
+    let p = shapes.ncols();
+    let dof_row = |d: Dof| -> Option<usize> { assembled.reduced_index(pt.node, d) };
+    let mut rows = vec![0.0; 3 * p];
+    let r = pt.offset;
+    let [ux, uy, uz, rx, ry, rz] =
+        [Dof::Ux, Dof::Uy, Dof::Uz, Dof::Rx, Dof::Ry, Dof::Rz].map(dof_row);
+    let value = |row: Option<usize>, mode: usize| row.map_or(0.0, |i| shapes[(i, mode)]);
+    for m in 0..p {
+        let (tx, ty, tz) = (value(rx, m), value(ry, m), value(rz, m));
+        // θ × r
+        let (cx, cy, cz) = (
+            ty * r.z - tz * r.y,
+            tz * r.x - tx * r.z,
+            tx * r.y - ty * r.x,
+        );
+        rows[m] = value(ux, m) + cx;
+        rows[p + m] = value(uy, m) + cy;
+        rows[2 * p + m] = value(uz, m) + cz;
+    }
+    rows
+}
+
+/// The node where a point given by its position sits; an error names `field` when no node is
+/// within `tolerance` of it.
+pub fn node_at(mesh: &Mesh, at: &Vector3<f64>, tolerance: f64, field: &str) -> Result<usize> {
+    let (node, distance) = mesh.nearest_node(at);
+    if distance <= tolerance {
+        Ok(node)
+    } else {
+        let x = mesh.nodes[node];
+        Err(Error::invalid(
+            field,
+            format!(
+                "no node at [{}, {}, {}]: the nearest is {distance:.3e} m away, at [{:.6}, {:.6}, {:.6}]; put the point on a node (a path vertex, or a multiple of the mesh size along a segment)",
+                at.x, at.y, at.z, x.x, x.y, x.z
+            ),
+        ))
+    }
+}
