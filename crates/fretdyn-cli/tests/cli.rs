@@ -253,3 +253,26 @@ fn verify_passes() {
         assert!(s.0.join("v").join(f).is_file(), "{f}");
     }
 }
+
+#[test]
+fn modes_prints_the_table_and_writes_basis_and_picture() {
+    let s = Scratch::new("modes");
+    let case = examples().join("tube_clamped_one_support.toml");
+    let out = fretdyn(&["modes", case.to_str().unwrap(), "-o", "m"], &s.0);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // first clamped–clamped bending mode of the water-filled tube: β₁L = 4.730,
+    // f = β² √(EI/m)/2π with m = tube + inner water + added mass = 1.0128 kg/m (78.94 Hz)
+    assert!(stdout.contains("    1      78.93"), "{stdout}");
+    assert!(stdout.contains("114 free DOFs"), "{stdout}");
+    for f in ["basis.npz", "mode_shapes.png"] {
+        assert!(s.0.join("m").join(f).is_file(), "{f}");
+    }
+    let back = fretdyn::output::read_basis_npz(&s.0.join("m/basis.npz")).unwrap();
+    assert_eq!(back.basis.modes(), 12);
+    assert_eq!(back.basis.points.len(), 2);
+}

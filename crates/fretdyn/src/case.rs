@@ -219,6 +219,8 @@ struct SupportInput {
     #[serde(rename = "type")]
     kind: SupportKind,
     stiffness: Option<[f64; 6]>,
+    #[serde(default)]
+    fixed: Vec<DofName>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy)]
@@ -227,6 +229,18 @@ enum SupportKind {
     Clamped,
     Pinned,
     Springs,
+    Dofs,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+enum DofName {
+    Ux,
+    Uy,
+    Uz,
+    Rx,
+    Ry,
+    Rz,
 }
 
 #[derive(Debug, Deserialize)]
@@ -507,24 +521,26 @@ impl TubeInput {
         for (k, sup) in self.supports.iter().enumerate() {
             let field = format!("structure.supports[{k}]");
             let node = node_at(&mesh, &v3(sup.at), tolerance, &format!("{field}.at"))?;
+            if !sup.fixed.is_empty() && !matches!(sup.kind, SupportKind::Dofs) {
+                return Err(Error::invalid(
+                    format!("{field}.fixed"),
+                    "only type = \"dofs\" takes a list of fixed DOFs",
+                ));
+            }
             let r = match (sup.kind, sup.stiffness) {
                 (SupportKind::Clamped, None) => clamped(),
                 (SupportKind::Pinned, None) => pinned(),
-                (SupportKind::Springs, Some(k)) => {
-                    if let Some(v) = k.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
-                        return Err(Error::invalid(
-                            format!("{field}.stiffness"),
-                            format!("spring stiffnesses must be ≥ 0 (got {v})"),
-                        ));
+                (SupportKind::Dofs, springs) => {
+                    let mut r = match springs {
+                        Some(k) => spring_restraints(&k, &field)?,
+                        None => [Restraint::Free; 6],
+                    };
+                    for d in &sup.fixed {
+                        r[*d as usize] = Restraint::Fixed;
                     }
-                    k.map(|v| {
-                        if v > 0.0 {
-                            Restraint::Spring(v)
-                        } else {
-                            Restraint::Free
-                        }
-                    })
+                    r
                 }
+                (SupportKind::Springs, Some(k)) => spring_restraints(&k, &field)?,
                 (SupportKind::Springs, None) => {
                     return Err(Error::invalid(
                         format!("{field}.stiffness"),
@@ -534,7 +550,7 @@ impl TubeInput {
                 (_, Some(_)) => {
                     return Err(Error::invalid(
                         format!("{field}.stiffness"),
-                        "only type = \"springs\" takes stiffnesses",
+                        "only type = \"springs\" or \"dofs\" takes stiffnesses",
                     ));
                 }
             };
@@ -593,6 +609,23 @@ impl TubeInput {
             damping,
         })
     }
+}
+
+/// Grounded springs `[kx, ky, kz, krx, kry, krz]` (0 = free).
+fn spring_restraints(k: &[f64; 6], field: &str) -> Result<[Restraint; 6]> {
+    if let Some(v) = k.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+        return Err(Error::invalid(
+            format!("{field}.stiffness"),
+            format!("spring stiffnesses must be ≥ 0 (got {v})"),
+        ));
+    }
+    Ok(k.map(|v| {
+        if v > 0.0 {
+            Restraint::Spring(v)
+        } else {
+            Restraint::Free
+        }
+    }))
 }
 
 /// A tube case keeps its finite-element model and full modes (for `fretdyn modes`).

@@ -498,3 +498,49 @@ fn npz_mass_normalisation_is_checked_when_the_mass_matrix_is_given() {
         other => panic!("expected Error::Npz, got {other:?}"),
     }
 }
+
+/// Tube supports: `type = "dofs"` with the six DOFs listed is a clamp, with the three
+/// translations a pin; a point off the nodes is refused with the nearest node.
+#[test]
+fn tube_supports_by_dof_equal_the_named_ones() {
+    let case = |supports: &str| {
+        let text = format!(
+            r#"
+[time]
+dt = 1e-6
+duration = 1e-4
+[structure]
+type = "tube"
+outer_diameter = 19.05e-3
+wall_thickness = 1.09e-3
+young_modulus = 2.0e11
+poisson_ratio = 0.3
+density = 8200.0
+path = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]
+mesh_size = 0.1
+modes = 6
+{supports}
+[[structure.points]]
+name = "mid"
+at = [0.5, 0.0, 0.0]
+"#
+        );
+        Case::from_toml_str(&text, Path::new("."))
+    };
+    let named = case(
+        "[[structure.supports]]\nat = [0.0, 0.0, 0.0]\ntype = \"clamped\"\n[[structure.supports]]\nat = [1.0, 0.0, 0.0]\ntype = \"pinned\"",
+    )
+    .unwrap();
+    let dofs = case(
+        "[[structure.supports]]\nat = [0.0, 0.0, 0.0]\ntype = \"dofs\"\nfixed = [\"ux\", \"uy\", \"uz\", \"rx\", \"ry\", \"rz\"]\n[[structure.supports]]\nat = [1.0, 0.0, 0.0]\ntype = \"dofs\"\nfixed = [\"ux\", \"uy\", \"uz\"]",
+    )
+    .unwrap();
+    assert_eq!(named.model.basis.omega, dofs.model.basis.omega);
+    let off = case("[[structure.supports]]\nat = [0.05, 0.0, 0.0]\ntype = \"clamped\"")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        off.contains("structure.supports[0].at") && off.contains("no node"),
+        "{off}"
+    );
+}
