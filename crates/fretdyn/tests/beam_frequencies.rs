@@ -139,6 +139,10 @@ fn bending_frequencies_match_euler_bernoulli() {
         let fe = bending_pairs(&f, &t, ends);
         for (k, (got, exact)) in fe.iter().zip(analytic_bending_hz(&t, ends)).enumerate() {
             let err = (got - exact).abs() / exact;
+            println!(
+                "{ends:?} mode {}: {got:.4} Hz, analytic {exact:.4} Hz, error {err:.2e}",
+                k + 1
+            );
             assert!(
                 err < 1e-3,
                 "{ends:?} mode {}: {got} Hz vs {exact} Hz ({err:e})",

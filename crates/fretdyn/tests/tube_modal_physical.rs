@@ -196,6 +196,7 @@ fn compare_all_modes(fx: f64, r: f64, methods: &[TangentialMethod]) {
                 }
             }
         }
+        assert_eq!(ra.status, rb.status, "{}: statuses differ", method.name());
         // displacement of every named point: u = rows q
         for (pa, pb) in physical.basis.points.iter().zip(&case.model.basis.points) {
             let (mut du, mut scale) = (0.0f64, 0.0f64);
