@@ -279,8 +279,9 @@ impl Tube {
     }
 }
 
-/// A degree of freedom of a node.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A degree of freedom of a node (in case files: "ux", "uy", "uz", "rx", "ry", "rz").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Dof {
     Ux,
     Uy,

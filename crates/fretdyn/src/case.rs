@@ -7,7 +7,7 @@ use nalgebra::Vector3;
 use serde::Deserialize;
 
 use crate::beam::{
-    BeamModel, Fluid, Material, Mesh, Restraint, Theory, Tube, TubeSection, clamped, pinned,
+    BeamModel, Dof, Fluid, Material, Mesh, Restraint, Theory, Tube, TubeSection, clamped, pinned,
 };
 use crate::contact::{Contact, NormalLaw};
 use crate::eigen::ModeSelection;
@@ -220,7 +220,7 @@ struct SupportInput {
     kind: SupportKind,
     stiffness: Option<[f64; 6]>,
     #[serde(default)]
-    fixed: Vec<DofName>,
+    fixed: Vec<Dof>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy)]
@@ -230,17 +230,6 @@ enum SupportKind {
     Pinned,
     Springs,
     Dofs,
-}
-
-#[derive(Debug, Deserialize, Clone, Copy)]
-#[serde(rename_all = "snake_case")]
-enum DofName {
-    Ux,
-    Uy,
-    Uz,
-    Rx,
-    Ry,
-    Rz,
 }
 
 #[derive(Debug, Deserialize)]

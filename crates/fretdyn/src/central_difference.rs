@@ -122,14 +122,7 @@ impl CentralDifference {
                 ..
             } => {
                 residual(force, stiffness, &self.q, damping, &self.qd, work);
-                for (i, out) in self.qdd.iter_mut().enumerate() {
-                    *out = m_inv
-                        .row(i)
-                        .iter()
-                        .zip(work.iter())
-                        .map(|(a, w)| a * w)
-                        .sum();
-                }
+                mat_vec(m_inv, work.as_slice(), &mut self.qdd);
             }
         }
     }
@@ -167,14 +160,7 @@ impl CentralDifference {
                 ..
             } => {
                 residual(force, stiffness, &self.q, damping, &self.qd_star, work);
-                for (i, out) in self.qdd.iter_mut().enumerate() {
-                    *out = a_inv
-                        .row(i)
-                        .iter()
-                        .zip(work.iter())
-                        .map(|(a, w)| a * w)
-                        .sum();
-                }
+                mat_vec(a_inv, work.as_slice(), &mut self.qdd);
             }
         }
     }
@@ -188,11 +174,7 @@ impl CentralDifference {
                     out[i] = a_inv[i] * l[i];
                 }
             }
-            Operators::Dense { a_inv, .. } => {
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o = a_inv.row(i).iter().zip(l).map(|(a, v)| a * v).sum();
-                }
-            }
+            Operators::Dense { a_inv, .. } => mat_vec(a_inv, l, out),
         }
     }
 
@@ -249,6 +231,13 @@ fn residual(
             r -= k[(i, j)] * q[j] + c[(i, j)] * v[j];
         }
         work[i] = r;
+    }
+}
+
+/// `out = A x`.
+fn mat_vec(a: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = a.row(i).iter().zip(x).map(|(a, v)| a * v).sum();
     }
 }
 

@@ -93,15 +93,7 @@ impl TubeStructure {
                 })
                 .collect(),
         };
-        let points = self
-            .points
-            .iter()
-            .map(|pt| Point {
-                name: pt.name.clone(),
-                coords: self.beam.mesh.nodes[pt.node] + pt.offset,
-                rows: point_rows(&assembled, &modes.shapes, pt),
-            })
-            .collect();
+        let points = self.named_points(&assembled, &modes.shapes);
         Ok(TubeBasis {
             basis: ModalBasis {
                 omega: modes.omega.clone(),
@@ -118,16 +110,7 @@ impl TubeStructure {
     pub fn physical_model(&self, alpha: f64, beta: f64) -> Result<Model> {
         let assembled = self.beam.assemble()?;
         let n = assembled.mass.nrows();
-        let identity = DMatrix::<f64>::identity(n, n);
-        let points = self
-            .points
-            .iter()
-            .map(|pt| Point {
-                name: pt.name.clone(),
-                coords: self.beam.mesh.nodes[pt.node] + pt.offset,
-                rows: point_rows(&assembled, &identity, pt),
-            })
-            .collect();
+        let points = self.named_points(&assembled, &DMatrix::<f64>::identity(n, n));
         let damping = &assembled.mass * alpha + &assembled.stiffness * beta;
         Ok(Model::physical(
             PhysicalMatrices {
@@ -137,6 +120,20 @@ impl TubeStructure {
             },
             points,
         ))
+    }
+}
+
+impl TubeStructure {
+    /// The named points with their rows taken from `shapes` (n × p, over the reduced DOFs).
+    fn named_points(&self, assembled: &Assembled, shapes: &DMatrix<f64>) -> Vec<Point> {
+        self.points
+            .iter()
+            .map(|pt| Point {
+                name: pt.name.clone(),
+                coords: self.beam.mesh.nodes[pt.node] + pt.offset,
+                rows: point_rows(assembled, shapes, pt),
+            })
+            .collect()
     }
 }
 

@@ -129,16 +129,20 @@ impl ActiveSet {
             let mut status_changed = false;
             let mut direction_changed = false;
             for (k, slot) in problem.slots().iter().enumerate() {
+                // contact k's exact local problem, the others frozen
+                let local = |lambda: &[Vector2<f64>]| {
+                    local_solve(
+                        &problem.block(k, k),
+                        &problem.local_rhs(k, lambda),
+                        slot.s_static,
+                        slot.s_dynamic,
+                        LocalSolve::Exact,
+                    )
+                };
                 if self.stick[k] {
                     if lambda[k].norm() > slot.s_static * (1.0 + 1e-12) {
                         self.stick[k] = false;
-                        let (local, _) = local_solve(
-                            &problem.block(k, k),
-                            &problem.local_rhs(k, lambda),
-                            slot.s_static,
-                            slot.s_dynamic,
-                            LocalSolve::Exact,
-                        );
+                        let (local, _) = local(lambda);
                         let n = local.norm();
                         self.direction[k] = if n > 0.0 {
                             local / n
@@ -149,13 +153,7 @@ impl ActiveSet {
                     }
                 } else {
                     let w = problem.residual_velocity(k, lambda);
-                    let (local, local_slide) = local_solve(
-                        &problem.block(k, k),
-                        &problem.local_rhs(k, lambda),
-                        slot.s_static,
-                        slot.s_dynamic,
-                        LocalSolve::Exact,
-                    );
+                    let (local, local_slide) = local(lambda);
                     if local_slide == Slide::Stick {
                         self.stick[k] = true;
                         status_changed = true;
