@@ -1,0 +1,80 @@
+"""The files fretdyn writes open in numpy in one call, and a basis written by numpy is read by
+fretdyn. Run by .ci/run in a venv with numpy and pytest; FRETDYN is the binary's path."""
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+FRETDYN = os.environ.get("FRETDYN", str(ROOT / "target" / "release" / "fretdyn"))
+
+
+def run(args, cwd):
+    return subprocess.run([FRETDYN, *args], cwd=cwd, capture_output=True, text=True)
+
+
+def test_results_open_in_numpy(tmp_path):
+    p = run(["run", str(ROOT / "examples" / "v1c_sliding_impact.toml"), "-o", "out", "-q"], tmp_path)
+    assert p.returncode == 0, p.stderr
+    r = np.load(tmp_path / "out" / "results.npz")
+    n = len(r["t"])
+    assert r["q"].shape == (n, 3) and r["qdot"].shape == (n, 3)
+    assert r["contact_normal_force"].shape == (n, 1)
+    assert r["contact_tangential_force"].shape == (n, 1, 2)
+    assert r["contact_slip_velocity"].shape == (n, 1, 2)
+    assert r["contact_penetration"].shape == (n, 1)
+    assert r["contact_status"].dtype == np.int8
+    # V1c (THEORY §6): the mass leaves with V sin α − 2 μ V cos α along the plane
+    v = r["qdot"][-1]  # a 1 kg point mass: modal velocity = physical velocity
+    expected = np.sin(np.radians(60)) - 2 * 0.3 * np.cos(np.radians(60))
+    assert abs(np.hypot(v[0], v[1]) - expected) < 1e-4
+    s = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert s["contacts"][0]["name"] == "plane"
+    assert s["termination"]["status"] == "completed"
+
+
+def test_a_basis_written_by_numpy_is_read(tmp_path):
+    # a 2 kg point mass as a general modal basis: three rigid modes, rows I/√m
+    m = 2.0
+    phi = np.eye(3) / np.sqrt(m)
+    np.savez(
+        tmp_path / "basis.npz",
+        frequencies_hz=np.zeros(3),
+        damping_ratio=np.zeros(3),
+        rows_mass=phi,
+        coords_mass=np.zeros(3),
+        mass_matrix=m * np.eye(3),
+        shapes=phi,
+    )
+    case = (ROOT / "examples" / "v1a_modal_inline.toml").read_text()
+    i, j = case.index("[structure]"), case.index("[initial]")
+    case = case[:i] + '[structure]\ntype = "modal"\nfile = "basis.npz"\n\n' + case[j:]
+    (tmp_path / "case.toml").write_text(case)
+    p = run(["run", "case.toml", "-o", "out", "-q"], tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "warning" not in p.stderr
+    r = np.load(tmp_path / "out" / "results.npz")
+    # peak normal force m v_n ω with ω = √(K_N/m)
+    vn = np.cos(np.radians(20))
+    assert abs(r["contact_normal_force"].max() - m * vn * np.sqrt(1e6 / m)) < 1e-3 * m * vn * np.sqrt(1e6 / m)
+
+
+def test_a_badly_normalised_basis_is_refused(tmp_path):
+    phi = np.eye(3)
+    np.savez(
+        tmp_path / "basis.npz",
+        frequencies_hz=np.zeros(3),
+        rows_mass=phi,
+        mass_matrix=2.0 * np.eye(3),
+        shapes=phi,
+    )
+    (tmp_path / "case.toml").write_text(
+        '[time]\ndt = 1e-6\nduration = 1e-4\n[structure]\ntype = "modal"\nfile = "basis.npz"\n'
+    )
+    p = run(["run", "case.toml", "-o", "out"], tmp_path)
+    assert p.returncode == 2
+    assert "not mass-normalised" in p.stderr and len(p.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
