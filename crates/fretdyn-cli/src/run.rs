@@ -186,7 +186,7 @@ fn report(case: &Case, r: &RunResults, dir: &Path) {
     let s = &r.solver;
     if case.settings.method.is_lagrange() {
         println!(
-            "  solver: GS sweeps mean {:.2} max {} non-converged {}; AS iterations mean {:.2} max {} cycles {} fallbacks {}; singular H {}",
+            "  solver: GS sweeps mean {:.2} max {} non-converged {}; AS iterations mean {:.2} max {} cycles {} fallbacks {}; singular H {}; residual mean {:.1e} max {:.1e}, steps > 1e-8: {}",
             s.gs_sweeps_mean(),
             s.gs_sweeps_max,
             s.gs_nonconverged_steps,
@@ -194,7 +194,10 @@ fn report(case: &Case, r: &RunResults, dir: &Path) {
             s.as_iterations_max,
             s.as_cycles,
             s.as_fallbacks,
-            s.singular_delassus
+            s.singular_delassus,
+            s.residual_mean(),
+            s.residual_max,
+            s.residual_steps_above_1e_8
         );
     }
     println!("  wrote {}", dir.display());

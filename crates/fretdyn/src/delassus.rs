@@ -16,6 +16,8 @@
 
 use nalgebra::{Matrix2, Vector2, Vector3};
 
+use crate::friction::Slide;
+
 /// One closed contact in the tangential problem.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Slot {
@@ -243,6 +245,35 @@ impl TangentialProblem {
     #[inline]
     pub fn residual_velocity(&self, k: usize, lambda: &[Vector2<f64>]) -> Vector2<f64> {
         self.local_rhs(k, lambda) - self.block(k, k) * lambda[k]
+    }
+
+    /// Natural-map residual of the tangential problem (THEORY §4.2), the same measure for
+    /// every solver: per contact `r_i = λ_i − proj_{disk(s_i)}(λ_i + ρ_i w_i)` with
+    /// `w = b − Hλ` (the slip velocity over θΔt, along which a sliding λ points),
+    /// `ρ_i = 2/tr(H_ii)` and `s_i` the static threshold of a sticking contact, the dynamic one
+    /// of a sliding contact; it is 0 exactly when λ satisfies Coulomb's law. Returned as
+    /// `‖r‖ / max(‖λ‖, max_i s_i)`, relative to the friction forces at stake.
+    pub fn natural_map_residual(&self, lambda: &[Vector2<f64>], slide: &[Slide]) -> f64 {
+        let mut r2 = 0.0;
+        let mut l2 = 0.0;
+        let mut s_max = 0.0f64;
+        for (k, slot) in self.slots.iter().enumerate() {
+            let h = self.block(k, k);
+            let trace = h[(0, 0)] + h[(1, 1)];
+            let rho = if trace > 0.0 { 2.0 / trace } else { 0.0 };
+            let s = match slide[k] {
+                Slide::Stick => slot.s_static,
+                Slide::Slip => slot.s_dynamic,
+            };
+            let z = lambda[k] + self.residual_velocity(k, lambda) * rho;
+            let n = z.norm();
+            let projected = if n > s { z * (s / n) } else { z };
+            r2 += (lambda[k] - projected).norm_squared();
+            l2 += lambda[k].norm_squared();
+            s_max = s_max.max(slot.s_static);
+        }
+        let scale = l2.sqrt().max(s_max);
+        if scale > 0.0 { r2.sqrt() / scale } else { 0.0 }
     }
 
     /// `q̈ −= A⁻¹ Lᵀ λ`.

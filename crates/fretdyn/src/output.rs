@@ -74,6 +74,7 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
             "counters": s,
             "gauss_seidel_sweeps_mean": s.gs_sweeps_mean(),
             "active_set_iterations_mean": s.as_iterations_mean(),
+            "natural_map_residual_mean": s.residual_mean(),
         },
         "performance": {
             "wall_time_s": results.wall_time,

@@ -581,6 +581,8 @@ impl<'m> Simulation<'m> {
                 );
             }
         }
+        self.solver_stats
+            .add_residual(problem.natural_map_residual(&lambda[..m], &slide[..m]));
         problem.apply(&lambda[..m], &mut self.cd.qdd);
         history.iter_mut().for_each(|h| h.closed = false);
         for (k, slot) in problem.slots().iter().enumerate() {

@@ -143,12 +143,37 @@ pub struct SolverStatistics {
     pub as_fallbacks: u64,
     /// Direct solves whose `H_SS` was singular and regularised (THEORY §4.6).
     pub singular_delassus: u64,
+    /// Largest natural-map residual of a step (relative; see
+    /// [`TangentialProblem::natural_map_residual`](crate::delassus::TangentialProblem::natural_map_residual)).
+    pub residual_max: f64,
+    /// Sum of the steps' residuals (the mean is `residual_sum / lagrange_steps`).
+    pub residual_sum: f64,
+    /// Steps whose residual is above 1e-8.
+    pub residual_steps_above_1e_8: u64,
 }
 
 impl SolverStatistics {
     /// Mean Gauss–Seidel sweeps per Lagrange step.
     pub fn gs_sweeps_mean(&self) -> f64 {
         ratio(self.gs_sweeps_total, self.lagrange_steps)
+    }
+
+    /// Mean natural-map residual per Lagrange step.
+    pub fn residual_mean(&self) -> f64 {
+        if self.lagrange_steps == 0 {
+            0.0
+        } else {
+            self.residual_sum / self.lagrange_steps as f64
+        }
+    }
+
+    /// Counts one step's residual.
+    pub fn add_residual(&mut self, r: f64) {
+        self.residual_max = self.residual_max.max(r);
+        self.residual_sum += r;
+        if !(r <= 1e-8) {
+            self.residual_steps_above_1e_8 += 1;
+        }
     }
 
     /// Mean Active Set iterations per Lagrange step.
