@@ -16,7 +16,7 @@ use crate::friction::{Coulomb, LocalSolve};
 use crate::load::{PointLoad, TimeHistory};
 use crate::modal::{ModalBasis, PinnedBeam, Point};
 use crate::model::Model;
-use crate::obstacle::{Obstacle, Plane};
+use crate::obstacle::{BiPlane, Circle, Obstacle, Plane};
 use crate::simulation::RunSettings;
 use crate::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
@@ -296,6 +296,18 @@ enum ObstacleInput {
         origin: [f64; 3],
         normal: [f64; 3],
         #[serde(default)]
+        gap: f64,
+        tangent: Option<[f64; 3]>,
+    },
+    Circle {
+        centre: [f64; 3],
+        axis: [f64; 3],
+        clearance: f64,
+    },
+    BiPlane {
+        #[serde(default)]
+        origin: [f64; 3],
+        normal: [f64; 3],
         gap: f64,
         tangent: Option<[f64; 3]>,
     },
@@ -654,6 +666,28 @@ impl CaseFile {
                     gap,
                     tangent,
                 } => Obstacle::Plane(Plane::new(
+                    v3(origin),
+                    v3(normal),
+                    gap,
+                    tangent.map(v3),
+                    &format!("{field}.obstacle"),
+                )?),
+                ObstacleInput::Circle {
+                    centre,
+                    axis,
+                    clearance,
+                } => Obstacle::Circle(Circle::new(
+                    v3(centre),
+                    v3(axis),
+                    clearance,
+                    &format!("{field}.obstacle"),
+                )?),
+                ObstacleInput::BiPlane {
+                    origin,
+                    normal,
+                    gap,
+                    tangent,
+                } => Obstacle::BiPlane(BiPlane::new(
                     v3(origin),
                     v3(normal),
                     gap,

@@ -32,10 +32,12 @@ pub fn stable_time_step(model: &Model, method: &TangentialMethod) -> f64 {
     };
     for contact in &model.contacts {
         let rows = &model.basis.points[contact.point].rows;
-        let (n, t) = contact.obstacle.stiffness_directions();
-        add_direction(&mut k, rows, &n, contact.normal.stiffness);
-        add_direction(&mut c, rows, &n, contact.normal.damping);
-        for ta in &t {
+        let (normals, tangents) = contact.obstacle.penalty_directions();
+        for n in &normals {
+            add_direction(&mut k, rows, n, contact.normal.stiffness);
+            add_direction(&mut c, rows, n, contact.normal.damping);
+        }
+        for ta in &tangents {
             add_direction(&mut k, rows, ta, kt);
             add_direction(&mut c, rows, ta, ct);
         }

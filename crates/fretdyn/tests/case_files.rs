@@ -544,3 +544,47 @@ at = [0.5, 0.0, 0.0]
         "{off}"
     );
 }
+
+#[test]
+fn circle_and_bi_plane_obstacles_from_toml() {
+    let text = |obstacle: &str| {
+        format!(
+            r#"
+[time]
+dt = 1e-6
+duration = 1e-4
+[structure]
+type = "point_mass"
+mass = 1.0
+[[contacts]]
+point = "mass"
+obstacle = {obstacle}
+normal = {{ stiffness = 1e6 }}
+friction = {{ mu = 0.3 }}
+"#
+        )
+    };
+    let c = Case::from_toml_str(
+        &text(r#"{ type = "circle", centre = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 2.0], clearance = 2e-4 }"#),
+        Path::new("."),
+    )
+    .unwrap();
+    // the mass sits on the hole's axis: 0.2 mm of clearance all round
+    let f = c.model.contacts[0].frame(&nalgebra::Vector3::zeros());
+    assert_eq!(f.penetration, -2e-4);
+    assert_eq!(f.tangents[1], nalgebra::Vector3::z());
+    let b = Case::from_toml_str(
+        &text(r#"{ type = "bi_plane", normal = [0.0, 1.0, 0.0], gap = 1e-4 }"#),
+        Path::new("."),
+    )
+    .unwrap();
+    let f = b.model.contacts[0].frame(&nalgebra::Vector3::new(0.0, 3e-4, 0.0));
+    assert!((f.penetration - 2e-4).abs() < 1e-15 && f.normal == -nalgebra::Vector3::y());
+    let e = Case::from_toml_str(
+        &text(r#"{ type = "circle", centre = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 1.0], clearance = -1.0 }"#),
+        Path::new("."),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("contacts[0].obstacle.clearance"), "{e}");
+}

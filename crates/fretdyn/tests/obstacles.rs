@@ -1,0 +1,176 @@
+//! The obstacles of THEORY §3 beyond the plane: a drilled hole (point–circle) and a pair of
+//! flat bars (bi-plane), against analytic solutions and an equivalent model.
+
+use fretdyn::contact::{Contact, NormalLaw};
+use fretdyn::friction::Coulomb;
+use fretdyn::modal::ModalBasis;
+use fretdyn::model::Model;
+use fretdyn::obstacle::{BiPlane, Circle, Obstacle, Plane};
+use fretdyn::simulation::{RunSettings, simulate};
+use fretdyn::tangential::{
+    ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
+};
+use nalgebra::Vector3;
+
+fn settings(method: TangentialMethod, dt: f64, steps: u64, every: u64) -> RunSettings {
+    RunSettings {
+        dt,
+        steps,
+        method,
+        stick_velocity: StickVelocity::HalfStep,
+        output_every: every,
+    }
+}
+
+/// A mass sliding round the inside of a hole of radius R (no other force): the wall holds it
+/// on the circle with `N = m v²/R`, friction slows it, `m dv/dt = −μ N`, so
+/// `v(t) = v₀ / (1 + μ v₀ t / R)`. The contact stays closed and slides all the time; its
+/// tangential velocity is circumferential, and the friction force opposes it.
+#[test]
+fn mass_sliding_round_a_hole_slows_down_as_coulomb_says() {
+    let (m, r, v0, mu, kn) = (1.0, 0.1, 1.0, 0.1, 1e8);
+    // start at the equilibrium penetration m v0²/(R K_N), moving along the circumference
+    let delta = m * v0 * v0 / (r * kn);
+    let mut model = Model::new(ModalBasis::point_mass(m, "mass", Vector3::zeros()).unwrap());
+    model.contacts.push(Contact {
+        name: "hole".into(),
+        point: 0,
+        obstacle: Obstacle::Circle(Circle::new(Vector3::zeros(), Vector3::z(), r, "hole").unwrap()),
+        normal: NormalLaw::new(kn, 2.0 * (kn * m).sqrt(), "n").unwrap(),
+        friction: Coulomb::new(mu, mu, "f").unwrap(),
+    });
+    model.initial.q = vec![(r + delta) * m.sqrt(), 0.0, 0.0];
+    model.initial.qdot = vec![0.0, v0 * m.sqrt(), 0.0];
+    let (dt, duration) = (2e-6, 0.5);
+    let steps = (duration / dt) as u64;
+    for method in [
+        TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
+        TangentialMethod::ActiveSet(ActiveSetSettings::default()),
+        TangentialMethod::Penalty(PenaltySettings {
+            stiffness: 1e6,
+            damping: 100.0,
+        }),
+    ] {
+        let res = simulate(&model, &settings(method, dt, steps, 1000)).unwrap();
+        let rec = &res.recorder;
+        let mut worst = 0.0f64;
+        for i in 1..rec.len() {
+            let t = rec.t[i];
+            let v = (rec.qdot[[i, 0]].powi(2) + rec.qdot[[i, 1]].powi(2)).sqrt() / m.sqrt();
+            let exact = v0 / (1.0 + mu * v0 * t / r);
+            worst = worst.max((v - exact).abs() / exact);
+            assert_eq!(
+                rec.status[[i, 0]],
+                2,
+                "{}: slides all the time",
+                method.name()
+            );
+            // friction opposes the (circumferential) slip
+            let (ft, vt) = (
+                rec.tangential_force[[i, 0, 0]],
+                rec.slip_velocity[[i, 0, 0]],
+            );
+            assert!(ft * vt < 0.0 && rec.slip_velocity[[i, 0, 1]].abs() < 1e-9 * v0);
+        }
+        assert!(worst < 2e-4, "{}: speed off by {worst:e}", method.name());
+        let c = &res.contacts[0];
+        assert_eq!(c.impacts, 1);
+        // the wear work is the kinetic energy lost
+        let v_end = v0 / (1.0 + mu * v0 * duration / r);
+        let lost = 0.5 * m * (v0 * v0 - v_end * v_end);
+        assert!(
+            (c.wear_work - lost).abs() < 1e-3 * lost,
+            "{}: {} vs {lost}",
+            method.name(),
+            c.wear_work
+        );
+    }
+}
+
+/// A bi-plane is the pair of planes it stands for: a mass bouncing between two bars at ±g
+/// with a sliding velocity moves exactly as with two plane contacts.
+#[test]
+fn bi_plane_equals_two_planes() {
+    let g = 1e-3;
+    let base = || {
+        let mut m = Model::new(ModalBasis::point_mass(1.0, "mass", Vector3::zeros()).unwrap());
+        m.initial.qdot = vec![0.3, 0.8, 0.1];
+        m
+    };
+    let law = NormalLaw::new(1e6, 0.0, "n").unwrap();
+    let friction = Coulomb::new(0.3, 0.25, "f").unwrap();
+    let contact = |name: &str, obstacle| Contact {
+        name: name.into(),
+        point: 0,
+        obstacle,
+        normal: law,
+        friction,
+    };
+    let mut bars = base();
+    bars.contacts.push(contact(
+        "bars",
+        Obstacle::BiPlane(
+            BiPlane::new(Vector3::zeros(), Vector3::y(), g, Some(Vector3::x()), "b").unwrap(),
+        ),
+    ));
+    let mut planes = base();
+    for (name, n) in [("below", Vector3::y()), ("above", -Vector3::y())] {
+        planes.contacts.push(contact(
+            name,
+            Obstacle::Plane(Plane::new(Vector3::zeros(), n, g, Some(Vector3::x()), "p").unwrap()),
+        ));
+    }
+    for method in [
+        TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
+        TangentialMethod::Penalty(PenaltySettings {
+            stiffness: 1e6,
+            damping: 10.0,
+        }),
+    ] {
+        let s = settings(method, 1e-6, 30_000, 1);
+        let a = simulate(&bars, &s).unwrap();
+        let b = simulate(&planes, &s).unwrap();
+        assert!(a.contacts[0].impacts >= 4, "{:?}", a.contacts[0]);
+        assert_eq!(
+            a.contacts[0].impacts,
+            b.contacts[0].impacts + b.contacts[1].impacts
+        );
+        for i in 0..a.recorder.len() {
+            for k in 0..3 {
+                let (x, y) = (a.recorder.q[[i, k]], b.recorder.q[[i, k]]);
+                assert!(
+                    (x - y).abs() <= 1e-12,
+                    "{}: step {i}: {x} vs {y}",
+                    method.name()
+                );
+            }
+            let rn = b.recorder.normal_force[[i, 0]] + b.recorder.normal_force[[i, 1]];
+            assert!((a.recorder.normal_force[[i, 0]] - rn).abs() <= 1e-9);
+        }
+        let w = a.contacts[0].wear_work;
+        let wb = b.contacts[0].wear_work + b.contacts[1].wear_work;
+        assert!((w - wb).abs() <= 1e-9 * w, "{w} vs {wb}");
+    }
+}
+
+#[test]
+fn obstacle_input_errors() {
+    assert!(
+        Circle::new(Vector3::zeros(), Vector3::zeros(), 1e-4, "c")
+            .unwrap_err()
+            .to_string()
+            .contains("c.axis")
+    );
+    assert!(
+        Circle::new(Vector3::zeros(), Vector3::z(), -1e-4, "c")
+            .unwrap_err()
+            .to_string()
+            .contains("c.clearance")
+    );
+    assert!(
+        BiPlane::new(Vector3::zeros(), Vector3::y(), f64::NAN, None, "b")
+            .unwrap_err()
+            .to_string()
+            .contains("b.gap")
+    );
+}
