@@ -294,6 +294,28 @@ impl TangentialProblem {
         }
     }
 
+    /// Whether `H` is singular (redundant constraints, THEORY §4.6): a Cholesky pivot below
+    /// `1e-12` of the largest diagonal term. `work` must hold `(2m)² + 4m` values.
+    pub fn is_singular(&self, work: &mut [f64]) -> bool {
+        let n = 2 * self.slots.len();
+        if n == 0 {
+            return false;
+        }
+        let (a, rest) = work.split_at_mut(n * n);
+        let (x, rest) = rest.split_at_mut(n);
+        let diag = &mut rest[..n];
+        let mut dmax = 0.0f64;
+        for i in 0..n {
+            for j in 0..n {
+                a[i * n + j] = self.h(i, j);
+            }
+            diag[i] = a[i * n + i];
+            dmax = dmax.max(diag[i].abs());
+            x[i] = 0.0;
+        }
+        cholesky_solve(a, diag, x, n, 1e-12 * dmax.max(f64::MIN_POSITIVE))
+    }
+
     /// Solves `H_SS λ_S = b_S − H_SF λ_F` for the stick slots `S` (those with `stick[k]`),
     /// the others' λ fixed, by Cholesky on the `2|S|` unknowns. `work` must hold
     /// `(2m)² + 4m` values and `index` 2m. Returns true when `H_SS` was singular (a pivot below `1e-12`

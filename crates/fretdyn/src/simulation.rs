@@ -276,6 +276,8 @@ enum Tangential {
         /// Per contact: previous step's status, direction and λ (warm start).
         history: Vec<History>,
         previous_lambda: Vec<Vector2<f64>>,
+        /// Work space of the singularity check.
+        work: Vec<f64>,
     },
 }
 
@@ -516,6 +518,7 @@ impl<'m> Simulation<'m> {
             slide,
             history,
             previous_lambda,
+            work,
         } = &mut self.tangential
         else {
             return;
@@ -563,6 +566,11 @@ impl<'m> Simulation<'m> {
         self.solver_stats.lagrange_steps += 1;
         match solver {
             LagrangeSolver::GaussSeidel(s) => {
+                // Gauss–Seidel tolerates a singular H (the modal forces are unique, λ is
+                // not); it is counted all the same (THEORY §4.6).
+                if problem.is_singular(work) {
+                    self.solver_stats.singular_delassus += 1;
+                }
                 let sweeps = gauss_seidel::solve(s, problem, &mut lambda[..m], &mut slide[..m]);
                 self.solver_stats.gs_sweeps_total += sweeps.count as u64;
                 self.solver_stats.gs_sweeps_max =
@@ -707,6 +715,7 @@ impl Tangential {
             slide: vec![Slide::Stick; nc],
             history: vec![History::default(); nc],
             previous_lambda: vec![Vector2::zeros(); nc],
+            work: vec![0.0; 4 * nc * nc + 8 * nc],
         }
     }
 }

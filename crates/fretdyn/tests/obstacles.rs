@@ -174,3 +174,101 @@ fn obstacle_input_errors() {
             .contains("b.gap")
     );
 }
+
+/// Redundant constraints (THEORY §4.6): a mass pressed on two coincident planes, each of
+/// stiffness K_N, is the same mass on one plane of stiffness 2 K_N — the friction disks add up
+/// — although H is singular at every closed step. Every method runs to the end with bounded
+/// forces; the Lagrange methods give the single plane's motion and count the singular steps.
+#[test]
+fn two_coincident_planes_are_one_plane_of_double_stiffness() {
+    use fretdyn::load::{PointLoad, TimeHistory};
+    use fretdyn::simulation::Termination;
+    let model = |planes: &[(f64, &str)]| {
+        let mut m = Model::new(ModalBasis::point_mass(1.0, "mass", Vector3::zeros()).unwrap());
+        for (kn, name) in planes {
+            m.contacts.push(Contact {
+                name: (*name).into(),
+                point: 0,
+                obstacle: Obstacle::Plane(
+                    Plane::new(Vector3::zeros(), Vector3::z(), 0.0, Some(Vector3::x()), "p")
+                        .unwrap(),
+                ),
+                normal: NormalLaw::new(*kn, 0.0, "n").unwrap(),
+                friction: Coulomb::new(0.3, 0.3, "f").unwrap(),
+            });
+        }
+        // pressed down by 50 N, pushed sideways by 20 N at 5 Hz: friction capacity 15 N,
+        // so it sticks and slips in turn
+        m.loads.push(
+            PointLoad::new(0, Vector3::new(0.0, 0.0, -50.0), TimeHistory::Constant, "g").unwrap(),
+        );
+        m.loads.push(
+            PointLoad::new(
+                0,
+                Vector3::new(20.0, 5.0, 0.0),
+                TimeHistory::Harmonic {
+                    frequency_hz: 5.0,
+                    phase: 0.0,
+                },
+                "push",
+            )
+            .unwrap(),
+        );
+        m.initial.qdot = vec![0.2, 0.1, 0.0];
+        m
+    };
+    let double = model(&[(1e6, "a"), (1e6, "b")]);
+    let single = model(&[(2e6, "ab")]);
+    for method in [
+        TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
+        TangentialMethod::ActiveSet(ActiveSetSettings::default()),
+        TangentialMethod::Penalty(PenaltySettings {
+            stiffness: 1e6,
+            damping: 100.0,
+        }),
+    ] {
+        let s = settings(method, 1e-5, 40_000, 10);
+        let a = simulate(&double, &s).unwrap();
+        assert_eq!(a.termination, Termination::Completed, "{}", method.name());
+        let rec = &a.recorder;
+        assert!(
+            rec.tangential_force
+                .iter()
+                .all(|f| f.is_finite() && f.abs() < 100.0)
+        );
+        assert!(rec.normal_force.iter().all(|f| f.is_finite() && *f < 200.0));
+        if !method.is_lagrange() {
+            continue;
+        }
+        assert!(
+            a.solver.singular_delassus > 1000,
+            "{}: {:?}",
+            method.name(),
+            a.solver
+        );
+        let statuses: Vec<i8> = rec.status.column(0).to_vec();
+        assert!(
+            statuses.contains(&1) && statuses.contains(&2),
+            "sticks and slips"
+        );
+        let b = simulate(&single, &s).unwrap();
+        assert_eq!(b.solver.singular_delassus, 0);
+        let scale = b.recorder.q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for i in 0..rec.len() {
+            for k in 0..3 {
+                let d = (rec.q[[i, k]] - b.recorder.q[[i, k]]).abs();
+                assert!(d <= 1e-9 * scale, "{}: sample {i}: {d:e}", method.name());
+            }
+            for j in 0..2 {
+                let sum = rec.tangential_force[[i, 0, j]] + rec.tangential_force[[i, 1, j]];
+                let d = (sum - b.recorder.tangential_force[[i, 0, j]]).abs();
+                assert!(
+                    d <= 1e-6,
+                    "{}: sample {i}: friction {sum} vs {}",
+                    method.name(),
+                    b.recorder.tangential_force[[i, 0, j]]
+                );
+            }
+        }
+    }
+}

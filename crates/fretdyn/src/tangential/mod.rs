@@ -141,7 +141,8 @@ pub struct SolverStatistics {
     pub as_iteration_limit: u64,
     /// Active Set: steps solved by the Gauss–Seidel fallback (cycles + iteration limit).
     pub as_fallbacks: u64,
-    /// Direct solves whose `H_SS` was singular and regularised (THEORY §4.6).
+    /// Redundant constraints (THEORY §4.6): Gauss–Seidel steps whose `H` was singular
+    /// (tolerated), Active Set direct solves whose `H_SS` was singular (regularised).
     pub singular_delassus: u64,
     /// Largest natural-map residual of a step (relative; see
     /// [`TangentialProblem::natural_map_residual`](crate::delassus::TangentialProblem::natural_map_residual)).
