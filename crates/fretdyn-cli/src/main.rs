@@ -73,6 +73,10 @@ enum Command {
         /// Contacts of the synthetic tube.
         #[arg(long, default_value_t = 8)]
         contacts: usize,
+        /// Instead: the cost of a step over 10–200 modes × 1–50 contacts, per method, as a
+        /// table, `scaling.csv` and `scaling.png` in this folder.
+        #[arg(long, value_name = "DIR")]
+        scaling: Option<PathBuf>,
     },
 }
 
@@ -101,7 +105,11 @@ fn main() -> ExitCode {
             repeat,
             modes,
             contacts,
-        } => bench::main(steps, repeat, modes, contacts),
+            scaling,
+        } => match scaling {
+            Some(dir) => bench::scaling(&dir, steps.min(20_000)),
+            None => bench::main(steps, repeat, modes, contacts),
+        },
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,

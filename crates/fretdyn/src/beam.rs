@@ -420,6 +420,10 @@ pub struct Assembled {
     pub stiffness: DMatrix<f64>,
     /// Global DOF (`6 node + dof`) of each reduced index.
     pub free_dofs: Vec<usize>,
+    /// Inertia of a unit rigid translation of the whole structure and its supports,
+    /// `(M r_d)` over the free DOFs, one column per axis d (n × 3): the load of a base
+    /// acceleration is `−(M r) a`.
+    pub base_inertia: DMatrix<f64>,
 }
 
 impl Assembled {
@@ -496,10 +500,14 @@ impl BeamModel {
                 a[(free_dofs[i], free_dofs[j])]
             })
         };
+        let base_inertia = DMatrix::from_fn(free_dofs.len(), 3, |i, d| {
+            (0..nn).map(|node| m[(free_dofs[i], 6 * node + d)]).sum()
+        });
         Ok(Assembled {
             mass: pick(&m),
             stiffness: pick(&k),
             free_dofs,
+            base_inertia,
         })
     }
 }

@@ -59,10 +59,10 @@ pub fn rattling_tube(modes: usize, contacts: usize, method: TangentialMethod, st
             2 => (Vector3::y(), Vector3::x()),
             _ => (Vector3::z(), Vector3::x()),
         };
-        model.contacts.push(Contact {
-            name: format!("support{j}"),
-            point: j,
-            obstacle: Obstacle::Plane(
+        model.contacts.push(Contact::new(
+            format!("support{j}"),
+            j,
+            Obstacle::Plane(
                 Plane::new(
                     Vector3::new(stations[j].1, 0.0, 0.0),
                     normal,
@@ -72,9 +72,9 @@ pub fn rattling_tube(modes: usize, contacts: usize, method: TangentialMethod, st
                 )
                 .expect("valid plane"),
             ),
-            normal: NormalLaw::new(1e6, 0.0, "support").expect("K_N > 0"),
-            friction: Coulomb::new(0.3, 0.3, "support").expect("valid μ"),
-        });
+            NormalLaw::new(1e6, 0.0, "support").expect("K_N > 0"),
+            Coulomb::new(0.3, 0.3, "support").expect("valid μ"),
+        ));
     }
     let load = contacts; // index of the load point
     for (force, phase) in [

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use nalgebra::Vector3;
+use nalgebra::{Vector2, Vector3};
 use serde::Deserialize;
 
 use crate::beam::{
@@ -13,10 +13,11 @@ use crate::contact::{Contact, NormalLaw};
 use crate::eigen::ModeSelection;
 use crate::error::{Error, Result};
 use crate::friction::{Coulomb, LocalSolve};
-use crate::load::{PointLoad, TimeHistory};
+use crate::load::{BaseAcceleration, PointLoad, TimeHistory};
 use crate::modal::{ModalBasis, PinnedBeam, Point};
 use crate::model::Model;
-use crate::obstacle::{BiPlane, Circle, Obstacle, Plane};
+use crate::motion::Motion;
+use crate::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
 use crate::simulation::RunSettings;
 use crate::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
@@ -114,6 +115,7 @@ struct CaseFile {
     contacts: Vec<ContactSection>,
     #[serde(default)]
     loads: Vec<LoadSection>,
+    base_excitation: Option<BaseSection>,
     #[serde(default)]
     tangential: TangentialSection,
     #[serde(default)]
@@ -143,6 +145,8 @@ enum StructureSection {
         file: Option<String>,
         #[serde(default)]
         points: Vec<PointInput>,
+        /// 3 rows (x, y, z) of p values `Φᵀ M r`.
+        participation: Option<Vec<Vec<f64>>>,
     },
     Tube(Box<TubeInput>),
     PinnedBeam {
@@ -259,6 +263,8 @@ struct PointInput {
     #[serde(default)]
     coords: [f64; 3],
     rows: Vec<Vec<f64>>,
+    #[serde(default)]
+    rotations: Vec<Vec<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -284,8 +290,52 @@ struct ContactSection {
     name: Option<String>,
     point: String,
     obstacle: ObstacleInput,
+    #[serde(default)]
+    radius: f64,
+    motion: Option<MotionInput>,
     normal: NormalInput,
     friction: FrictionInput,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+enum MotionInput {
+    Velocity {
+        velocity: [f64; 3],
+    },
+    Harmonic {
+        amplitude: [f64; 3],
+        frequency_hz: f64,
+        #[serde(default)]
+        phase_deg: f64,
+    },
+    Table {
+        table: Vec<[f64; 4]>,
+    },
+}
+
+impl MotionInput {
+    fn motion(&self) -> Motion {
+        match self {
+            MotionInput::Velocity { velocity } => Motion::Velocity(v3(*velocity)),
+            MotionInput::Harmonic {
+                amplitude,
+                frequency_hz,
+                phase_deg,
+            } => Motion::Harmonic {
+                amplitude: v3(*amplitude),
+                frequency_hz: *frequency_hz,
+                phase: phase_deg.to_radians(),
+            },
+            MotionInput::Table { table } => Motion::Table {
+                times: table.iter().map(|r| r[0]).collect(),
+                displacements: table
+                    .iter()
+                    .map(|r| Vector3::new(r[1], r[2], r[3]))
+                    .collect(),
+            },
+        }
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -310,6 +360,15 @@ enum ObstacleInput {
         normal: [f64; 3],
         gap: f64,
         tangent: Option<[f64; 3]>,
+    },
+    Polygon {
+        centre: [f64; 3],
+        axis: [f64; 3],
+        reference: Option<[f64; 3]>,
+        /// In-plane vertices `[x1, x2]` along (reference, axis × reference), m.
+        vertices: Option<Vec<[f64; 2]>>,
+        /// Vertices as `[angle_deg, radius]` pairs.
+        polar: Option<Vec<[f64; 2]>>,
     },
 }
 
@@ -338,6 +397,14 @@ struct LoadSection {
     history: HistoryInput,
 }
 
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BaseSection {
+    acceleration: [f64; 3],
+    #[serde(default)]
+    history: HistoryInput,
+}
+
 #[derive(Debug, Default, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 enum HistoryInput {
@@ -348,6 +415,21 @@ enum HistoryInput {
         #[serde(default)]
         phase_deg: f64,
     },
+}
+
+impl HistoryInput {
+    fn history(&self) -> TimeHistory {
+        match *self {
+            HistoryInput::Constant => TimeHistory::Constant,
+            HistoryInput::Harmonic {
+                frequency_hz,
+                phase_deg,
+            } => TimeHistory::Harmonic {
+                frequency_hz,
+                phase: phase_deg.to_radians(),
+            },
+        }
+    }
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -694,6 +776,35 @@ impl CaseFile {
                     tangent.map(v3),
                     &format!("{field}.obstacle"),
                 )?),
+                ObstacleInput::Polygon {
+                    centre,
+                    axis,
+                    reference,
+                    ref vertices,
+                    ref polar,
+                } => {
+                    let vertices = match (vertices, polar) {
+                        (Some(v), None) => v.iter().map(|p| Vector2::new(p[0], p[1])).collect(),
+                        (None, Some(p)) => Polygon::polar(
+                            &p.iter()
+                                .map(|p| (p[0].to_radians(), p[1]))
+                                .collect::<Vec<_>>(),
+                        ),
+                        _ => {
+                            return Err(Error::invalid(
+                                format!("{field}.obstacle"),
+                                "a polygonal hole needs either vertices ([x1, x2] pairs, m) or polar ([angle_deg, radius] pairs), not both",
+                            ));
+                        }
+                    };
+                    Obstacle::Polygon(Polygon::new(
+                        v3(centre),
+                        v3(axis),
+                        reference.map(v3),
+                        vertices,
+                        &format!("{field}.obstacle"),
+                    )?)
+                }
             };
             let normal = NormalLaw::new(
                 c.normal.stiffness,
@@ -713,30 +824,34 @@ impl CaseFile {
                     ));
                 }
             };
-            model.contacts.push(Contact {
-                name: c.name.clone().unwrap_or_else(|| format!("contact{k}")),
-                point: pt,
+            let mut contact = Contact::new(
+                c.name.clone().unwrap_or_else(|| format!("contact{k}")),
+                pt,
                 obstacle,
                 normal,
-                friction: Coulomb::new(mu_s, mu_d, &ff)?,
-            });
+                Coulomb::new(mu_s, mu_d, &ff)?,
+            );
+            contact.radius = c.radius;
+            if let Some(m) = &c.motion {
+                contact.motion = m.motion();
+            }
+            contact.validate(&model.basis.points[pt], &field)?;
+            model.contacts.push(contact);
         }
         for (k, l) in self.loads.iter().enumerate() {
             let field = format!("loads[{k}]");
             let pt = point(&l.point, format!("{field}.point"), &model)?;
-            let history = match l.history {
-                HistoryInput::Constant => TimeHistory::Constant,
-                HistoryInput::Harmonic {
-                    frequency_hz,
-                    phase_deg,
-                } => TimeHistory::Harmonic {
-                    frequency_hz,
-                    phase: phase_deg.to_radians(),
-                },
-            };
+            let history = l.history.history();
             model
                 .loads
                 .push(PointLoad::new(pt, v3(l.force), history, &field)?);
+        }
+        if let Some(b) = &self.base_excitation {
+            model.base_acceleration = Some(BaseAcceleration::new(
+                v3(b.acceleration),
+                b.history.history(),
+                "base_excitation",
+            )?);
         }
         if let Some(init) = &self.initial {
             let p = model.basis.modes();
@@ -887,6 +1002,7 @@ impl StructureSection {
                 damping_ratio,
                 file,
                 points,
+                participation,
             } => {
                 let mut basis = match (file, frequencies_hz) {
                     (Some(f), None) => {
@@ -898,6 +1014,7 @@ impl StructureSection {
                         omega: freq.iter().map(|f| f * std::f64::consts::TAU).collect(),
                         damping_ratio: vec![0.0; freq.len()],
                         points: Vec::new(),
+                        participation: Vec::new(),
                     },
                     _ => {
                         return Err(Error::invalid(
@@ -913,6 +1030,16 @@ impl StructureSection {
                     None => {}
                 }
                 for (j, pt) in points.iter().enumerate() {
+                    if !(pt.rotations.is_empty()
+                        || pt.rotations.len() == 3 && pt.rotations.iter().all(|r| r.len() == p))
+                    {
+                        return Err(Error::invalid(
+                            format!("structure.points[{j}].rotations"),
+                            format!(
+                                "must be 3 rows (θx, θy, θz) of {p} values each, one value per mode"
+                            ),
+                        ));
+                    }
                     if pt.rows.len() != 3 || pt.rows.iter().any(|r| r.len() != p) {
                         return Err(Error::invalid(
                             format!("structure.points[{j}].rows"),
@@ -925,7 +1052,17 @@ impl StructureSection {
                         name: pt.name.clone(),
                         coords: v3(pt.coords),
                         rows: pt.rows.concat(),
+                        rotations: pt.rotations.concat(),
                     });
+                }
+                if let Some(g) = participation {
+                    if g.len() != 3 || g.iter().any(|r| r.len() != p) {
+                        return Err(Error::invalid(
+                            "structure.participation",
+                            format!("must be 3 rows (x, y, z) of {p} values Φᵀ M r, one per mode"),
+                        ));
+                    }
+                    basis.participation = g.concat();
                 }
                 Ok(basis)
             }

@@ -3,6 +3,10 @@
 
 use crate::error::{Error, Result};
 use crate::friction::Coulomb;
+use nalgebra::Vector3;
+
+use crate::modal::Point;
+use crate::motion::Motion;
 use crate::obstacle::{ContactFrame, Obstacle};
 
 /// Normal penalty law `R_N = max(0, K_N δ + C_N δ̇)` for `δ > 0`, `R_N = 0` otherwise (THEORY §3).
@@ -53,6 +57,15 @@ pub struct Contact {
     pub point: usize,
     /// The obstacle.
     pub obstacle: Obstacle,
+    /// Prescribed rigid motion of the obstacle ([`Motion::Fixed`] by default).
+    pub motion: Motion,
+    /// Outer radius `R` of the tube when the point is on its axis and the contact is on its
+    /// surface (0: the contact is at the point). The obstacle's gap or clearance is then the
+    /// clearance of the surface, the contact point is `x − R n`, and its velocity
+    /// `u̇ + θ̇ × (−R n) = u̇ + R n × θ̇`: the tube's rotations (torsion for the
+    /// circumferential slip in a hole, bending for the axial slip) enter the tangential
+    /// velocity and the friction force exerts a moment `−R n × R_T` on the tube.
+    pub radius: f64,
     /// Normal penalty law.
     pub normal: NormalLaw,
     /// Static and dynamic friction coefficients.
@@ -60,9 +73,87 @@ pub struct Contact {
 }
 
 impl Contact {
-    /// Frame of the obstacle at the point's physical position.
+    /// A contact at the point itself with a fixed obstacle.
+    pub fn new(
+        name: impl Into<String>,
+        point: usize,
+        obstacle: Obstacle,
+        normal: NormalLaw,
+        friction: Coulomb,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            point,
+            obstacle,
+            motion: Motion::Fixed,
+            radius: 0.0,
+            normal,
+            friction,
+        }
+    }
+
+    /// Frame of the obstacle at time `t` for the point's physical position `x` (the tube axis
+    /// when `radius > 0`): the obstacle translated by `d(t)`, its surface moving at `ḋ(t)`.
     #[inline]
-    pub fn frame(&self, x: &nalgebra::Vector3<f64>) -> ContactFrame {
-        self.obstacle.frame(x)
+    pub fn frame(&self, x: &Vector3<f64>, t: f64) -> ContactFrame {
+        if self.motion.is_fixed() {
+            return self.obstacle.frame(x);
+        }
+        let (d, v) = self.motion.at(t);
+        let mut frame = self.obstacle.frame(&(x - d));
+        frame.velocity = v;
+        frame
+    }
+
+    /// True when the contact is on the tube surface rather than at the point.
+    #[inline]
+    pub fn at_surface(&self) -> bool {
+        self.radius > 0.0
+    }
+
+    /// Rows (3 × p) of the contact point on the surface for the normal `n`:
+    /// `Φ_u + R [n]_× Θ`, from the point's translation rows `Φ_u` and rotation rows `Θ`.
+    #[inline]
+    pub fn surface_rows(&self, point: &Point, n: &Vector3<f64>, out: &mut [f64]) {
+        let p = out.len() / 3;
+        let (u, th, r) = (&point.rows, &point.rotations, self.radius);
+        for i in 0..p {
+            let (tx, ty, tz) = (th[i], th[p + i], th[2 * p + i]);
+            out[i] = u[i] + r * (n.y * tz - n.z * ty);
+            out[p + i] = u[p + i] + r * (n.z * tx - n.x * tz);
+            out[2 * p + i] = u[2 * p + i] + r * (n.x * ty - n.y * tx);
+        }
+    }
+
+    /// The tangent basis when the contact's Delassus rows never change: a fixed tangent basis,
+    /// and (on the surface) a fixed normal.
+    pub fn fixed_tangents(&self) -> Option<[Vector3<f64>; 2]> {
+        match (&self.obstacle, self.at_surface()) {
+            (_, false) | (Obstacle::Plane(_), true) => self.obstacle.fixed_tangents(),
+            _ => None,
+        }
+    }
+
+    /// Checks the radius and the motion; `point` is the contact's point.
+    pub fn validate(&self, point: &Point, field: &str) -> Result<()> {
+        if !(self.radius.is_finite() && self.radius >= 0.0) {
+            return Err(Error::invalid(
+                format!("{field}.radius"),
+                format!(
+                    "must be the tube's outer radius ≥ 0 in m (got {})",
+                    self.radius
+                ),
+            ));
+        }
+        if self.at_surface() && point.rotations.is_empty() {
+            return Err(Error::invalid(
+                format!("{field}.radius"),
+                format!(
+                    "a contact on the tube surface needs the rotations of point '{}': use a tube structure, or give rotations (rows or 'rotations_<name>' in the .npz), or remove radius",
+                    point.name
+                ),
+            ));
+        }
+        self.motion.validate(&format!("{field}.motion"))
     }
 }

@@ -35,6 +35,7 @@ pub mod friction;
 pub mod load;
 pub mod modal;
 pub mod model;
+pub mod motion;
 pub mod obstacle;
 pub mod output;
 pub mod recorder;

@@ -20,6 +20,9 @@ pub struct Point {
     pub coords: Vector3<f64>,
     /// Translation rows, row-major 3 × p: `rows[d * p + i]` = component `d` of mode `i` at the point.
     pub rows: Vec<f64>,
+    /// Rotation rows, same layout (`θ_c = Θ_c q`, rad), or empty when the basis has none
+    /// (point masses, bases imported without them). A contact at the tube surface needs them.
+    pub rotations: Vec<f64>,
 }
 
 /// Properties of an analytic pinned–pinned beam ([`ModalBasis::pinned_beam`]).
@@ -50,6 +53,10 @@ pub struct ModalBasis {
     pub damping_ratio: Vec<f64>,
     /// Points with their rows.
     pub points: Vec<Point>,
+    /// Modal participation factors `Γ = Φᵀ M r` (row-major 3 × p: `participation[d * p + i]`
+    /// for a unit translation `r` of the whole structure along axis `d`), or empty when not
+    /// known. A base acceleration `a(t)` loads the modes with `−Γ a(t)`.
+    pub participation: Vec<f64>,
 }
 
 impl ModalBasis {
@@ -73,6 +80,7 @@ impl ModalBasis {
         }
         let s = 1.0 / mass.sqrt();
         let rows = vec![s, 0.0, 0.0, 0.0, s, 0.0, 0.0, 0.0, s];
+        let participation = rows.iter().map(|v| v * mass).collect();
         Ok(Self {
             omega: vec![0.0; 3],
             damping_ratio: vec![0.0; 3],
@@ -80,7 +88,9 @@ impl ModalBasis {
                 name: name.to_string(),
                 coords,
                 rows,
+                rotations: Vec::new(),
             }],
+            participation,
         })
     }
 
@@ -155,12 +165,27 @@ impl ModalBasis {
                 name: name.clone(),
                 coords: Vector3::new(*x, 0.0, 0.0),
                 rows,
+                rotations: Vec::new(),
             });
+        }
+        // Γ_k = ∫ ρA φ_k dx = √(2 ρA L) (1 − cos kπ)/(kπ), in the mode's direction
+        let gamma = |k: usize| {
+            let kpi = k as f64 * std::f64::consts::PI;
+            (2.0 * beam.mass_per_length * length).sqrt() * (1.0 - kpi.cos()) / kpi
+        };
+        let mut participation = vec![0.0; 3 * p];
+        for k in 1..=n {
+            participation[p + 2 * (k - 1)] = gamma(k);
+            participation[2 * p + 2 * (k - 1) + 1] = gamma(k);
+        }
+        for k in 1..=na {
+            participation[2 * n + k - 1] = gamma(k);
         }
         Ok(Self {
             omega,
             damping_ratio: vec![beam.damping_ratio; p],
             points,
+            participation,
         })
     }
 
@@ -191,6 +216,14 @@ impl ModalBasis {
                 ));
             }
         }
+        if !(self.participation.is_empty() || self.participation.len() == 3 * p)
+            || self.participation.iter().any(|v| !v.is_finite())
+        {
+            return Err(Error::invalid(
+                format!("{source}.participation"),
+                format!("must be 3 rows (x, y, z) of {p} finite values Φᵀ M r, or none"),
+            ));
+        }
         for (i, &xi) in self.damping_ratio.iter().enumerate() {
             check_damping_ratio(xi, &format!("{source}.damping_ratio[{i}]"))?;
         }
@@ -220,6 +253,26 @@ impl ModalBasis {
                         "mode shape is not finite ({}) at component {} of mode {}: fix or drop that mode",
                         pt.rows[k],
                         ["x", "y", "z"][k / p],
+                        k % p
+                    ),
+                ));
+            }
+            if !(pt.rotations.is_empty() || pt.rotations.len() == 3 * p) {
+                return Err(Error::invalid(
+                    format!("{source}.points.{}.rotations", pt.name),
+                    format!(
+                        "must be 3 rows (θx, θy, θz) of {p} values, one per mode, or none (got {} values)",
+                        pt.rotations.len()
+                    ),
+                ));
+            }
+            if let Some(k) = pt.rotations.iter().position(|v| !v.is_finite()) {
+                return Err(Error::invalid(
+                    format!("{source}.points.{}.rotations", pt.name),
+                    format!(
+                        "rotation of the mode shape is not finite ({}) at component {} of mode {}: fix or drop that mode",
+                        pt.rotations[k],
+                        ["θx", "θy", "θz"][k / p],
                         k % p
                     ),
                 ));

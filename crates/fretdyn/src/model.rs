@@ -3,7 +3,7 @@
 
 use crate::contact::Contact;
 use crate::error::{Error, Result};
-use crate::load::PointLoad;
+use crate::load::{BaseAcceleration, PointLoad};
 use crate::modal::ModalBasis;
 
 /// Initial modal state `q(0)`, `q̇(0)`.
@@ -52,6 +52,8 @@ pub struct Model {
     pub contacts: Vec<Contact>,
     /// Point loads.
     pub loads: Vec<PointLoad>,
+    /// Uniform acceleration of the base, if any (displacements are then relative to it).
+    pub base_acceleration: Option<BaseAcceleration>,
     /// Initial state.
     pub initial: InitialState,
 }
@@ -65,6 +67,7 @@ impl Model {
             coordinates: Coordinates::Modal,
             contacts: Vec::new(),
             loads: Vec::new(),
+            base_acceleration: None,
             initial: InitialState {
                 q: vec![0.0; p],
                 qdot: vec![0.0; p],
@@ -80,6 +83,7 @@ impl Model {
             omega: vec![0.0; n],
             damping_ratio: vec![0.0; n],
             points,
+            participation: Vec::new(),
         });
         model.coordinates = Coordinates::Physical(Box::new(matrices));
         model
@@ -117,6 +121,7 @@ impl Model {
                     "refers to no point of the structure",
                 ));
             }
+            c.validate(&self.basis.points[c.point], &format!("contacts[{k}]"))?;
         }
         for (k, l) in self.loads.iter().enumerate() {
             if l.point >= np {
@@ -125,6 +130,12 @@ impl Model {
                     "refers to no point of the structure",
                 ));
             }
+        }
+        if self.base_acceleration.is_some() && self.basis.participation.is_empty() {
+            return Err(Error::invalid(
+                "base_excitation",
+                "the modal basis has no participation factors Φᵀ M r: use a point_mass, pinned_beam or tube structure, or give participation (inline, or 'participation' in the .npz)",
+            ));
         }
         for (name, v) in [
             ("initial.q", &self.initial.q),

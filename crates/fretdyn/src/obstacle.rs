@@ -1,7 +1,7 @@
 //! Obstacle geometry: for a point position, the penetration `δ`, the outward normal `n` and the
 //! tangent basis `T` (THEORY §3).
 
-use nalgebra::Vector3;
+use nalgebra::{Vector2, Vector3};
 
 use crate::error::{Error, Result};
 
@@ -229,6 +229,151 @@ impl BiPlane {
     }
 }
 
+/// A broached (quatrefoil, trefoil) or any polygonal hole of a support plate, as the region
+/// the point (the tube axis) can move in: a simple polygon in the plane normal to the tube
+/// axis `a` through `c`, with vertices in the in-plane axes `(e1, e2 = a × e1)`. With `r` the
+/// in-plane position of the point and `b` the nearest point of the boundary: outside the
+/// polygon `δ = |r − b|`, `n = (b − r)/|r − b|` (back towards the hole); inside,
+/// `δ = −|r − b|`. On a flat land this is the point–plane law; at a corner the normal turns
+/// continuously. Tangents `[n × a, a]` (circumferential, axial), as for a circle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Polygon {
+    centre: Vector3<f64>,
+    axis: Vector3<f64>,
+    e1: Vector3<f64>,
+    e2: Vector3<f64>,
+    vertices: Vec<Vector2<f64>>,
+}
+
+impl Polygon {
+    /// Builds a hole from its vertices `(x1, x2)` along `(e1, e2)`, m; `reference` fixes `e1`
+    /// (projected on the plane; default: the global axis least aligned with `axis`).
+    pub fn new(
+        centre: Vector3<f64>,
+        axis: Vector3<f64>,
+        reference: Option<Vector3<f64>>,
+        vertices: Vec<Vector2<f64>>,
+        field: &str,
+    ) -> Result<Self> {
+        let circle = Circle::new(centre, axis, 0.0, field)?;
+        let a = circle.axis;
+        let e1 = match reference {
+            Some(r) => {
+                let rp = r - a * a.dot(&r);
+                if !(rp.norm() > 1e-12 * r.norm().max(1e-300)) || rp.iter().any(|v| !v.is_finite())
+                {
+                    return Err(Error::invalid(
+                        format!("{field}.reference"),
+                        "must be a finite vector not parallel to the axis",
+                    ));
+                }
+                rp.normalize()
+            }
+            None => circle.e1,
+        };
+        if vertices.len() < 3 {
+            return Err(Error::invalid(
+                format!("{field}.vertices"),
+                format!(
+                    "a polygonal hole needs at least 3 vertices (got {})",
+                    vertices.len()
+                ),
+            ));
+        }
+        if let Some(k) = vertices
+            .iter()
+            .position(|v| !v.iter().all(|x| x.is_finite()))
+        {
+            return Err(Error::invalid(
+                format!("{field}.vertices[{k}]"),
+                "must be finite numbers, in m",
+            ));
+        }
+        let n = vertices.len();
+        if let Some(k) = (0..n).find(|&k| (vertices[(k + 1) % n] - vertices[k]).norm() == 0.0) {
+            return Err(Error::invalid(
+                format!("{field}.vertices[{k}]"),
+                "repeats the next vertex: every edge must have a length",
+            ));
+        }
+        let polygon = Self {
+            centre,
+            axis: a,
+            e1,
+            e2: a.cross(&e1),
+            vertices,
+        };
+        if !polygon.contains(&Vector2::zeros()) {
+            return Err(Error::invalid(
+                format!("{field}.vertices"),
+                "the hole's centre (where the tube axis is at rest) must be inside the polygon",
+            ));
+        }
+        Ok(polygon)
+    }
+
+    /// Vertices of a hole given as `(angle, radius)` pairs: angle from `e1` towards `e2`, rad.
+    pub fn polar(pairs: &[(f64, f64)]) -> Vec<Vector2<f64>> {
+        pairs
+            .iter()
+            .map(|&(angle, radius)| Vector2::new(radius * angle.cos(), radius * angle.sin()))
+            .collect()
+    }
+
+    /// Crossing-number test: is the in-plane point `r` inside the polygon?
+    fn contains(&self, r: &Vector2<f64>) -> bool {
+        let v = &self.vertices;
+        let mut inside = false;
+        let mut j = v.len() - 1;
+        for i in 0..v.len() {
+            let (a, b) = (v[i], v[j]);
+            if (a.y > r.y) != (b.y > r.y) && r.x < (b.x - a.x) * (r.y - a.y) / (b.y - a.y) + a.x {
+                inside = !inside;
+            }
+            j = i;
+        }
+        inside
+    }
+
+    #[inline]
+    fn frame(&self, x: &Vector3<f64>) -> ContactFrame {
+        let d = x - self.centre;
+        let r = Vector2::new(d.dot(&self.e1), d.dot(&self.e2));
+        // nearest point of the boundary
+        let v = &self.vertices;
+        let (mut best, mut nearest) = (f64::INFINITY, v[0]);
+        let mut j = v.len() - 1;
+        for i in 0..v.len() {
+            let (a, b) = (v[j], v[i]);
+            let ab = b - a;
+            let s = ((r - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+            let p = a + ab * s;
+            let dist = (r - p).norm_squared();
+            if dist < best {
+                best = dist;
+                nearest = p;
+            }
+            j = i;
+        }
+        let dist = best.sqrt();
+        let inside = self.contains(&r);
+        let to_boundary = nearest - r;
+        let n2 = if dist > 0.0 {
+            (if inside { -to_boundary } else { to_boundary }) / dist
+        } else {
+            // on the boundary: back towards the centre
+            -r / r.norm().max(1e-300)
+        };
+        let normal = self.e1 * n2.x + self.e2 * n2.y;
+        ContactFrame {
+            penetration: if inside { -dist } else { dist },
+            normal,
+            tangents: [normal.cross(&self.axis), self.axis],
+            velocity: Vector3::zeros(),
+        }
+    }
+}
+
 /// The obstacles fretdyn knows.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Obstacle {
@@ -238,6 +383,8 @@ pub enum Obstacle {
     Circle(Circle),
     /// Two parallel bars at ±gap.
     BiPlane(BiPlane),
+    /// Point–polygon contact: a tube in a broached hole.
+    Polygon(Polygon),
 }
 
 impl Obstacle {
@@ -248,6 +395,7 @@ impl Obstacle {
             Obstacle::Plane(p) => p.frame(x),
             Obstacle::Circle(c) => c.frame(x),
             Obstacle::BiPlane(b) => b.frame(x),
+            Obstacle::Polygon(p) => p.frame(x),
         }
     }
 
@@ -257,7 +405,7 @@ impl Obstacle {
         match self {
             Obstacle::Plane(p) => Some(p.tangents),
             Obstacle::BiPlane(b) => Some(b.tangents),
-            Obstacle::Circle(_) => None,
+            Obstacle::Circle(_) | Obstacle::Polygon(_) => None,
         }
     }
 
@@ -272,6 +420,7 @@ impl Obstacle {
                 let e2 = c.axis.cross(&c.e1);
                 (vec![c.e1, e2], vec![c.e1, e2, c.axis])
             }
+            Obstacle::Polygon(p) => (vec![p.e1, p.e2], vec![p.e1, p.e2, p.axis]),
         }
     }
 }

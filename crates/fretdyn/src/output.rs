@@ -9,7 +9,11 @@
 //! - `damping_ratio` (p), optional: modal damping ratios (default 0, or the case's value);
 //! - `rows_<name>` (3, p): mode-shape rows of point `<name>` (x, y, z translations),
 //!   mass-normalised (`Φᵀ M Φ = I`);
-//! - `coords_<name>` (3), optional: the point's reference position, m.
+//! - `rotations_<name>` (3, p), optional: rotation rows of point `<name>` (θx, θy, θz, rad
+//!   per unit modal coordinate), needed for a contact at the tube surface (`radius`);
+//! - `coords_<name>` (3), optional: the point's reference position, m;
+//! - `participation` (3, p), optional: modal participation factors `Φᵀ M r` for unit rigid
+//!   translations along x, y, z (kg^½), needed for a base excitation.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -163,10 +167,27 @@ pub fn read_basis_npz(path: &Path) -> Result<BasisFile> {
         } else {
             Vector3::zeros()
         };
+        let rotations = if names.iter().any(|n| *n == format!("rotations_{name}")) {
+            let r: Array2<f64> = npz.by_name(&format!("rotations_{name}")).map_err(|e| {
+                npz_err(format!(
+                    "key 'rotations_{name}' must be float64 of shape (3, {p}): {e}"
+                ))
+            })?;
+            if r.shape() != [3, p] {
+                return Err(npz_err(format!(
+                    "'rotations_{name}' has shape {:?}, expected (3, {p}): θx, θy, θz rows, one column per mode",
+                    r.shape()
+                )));
+            }
+            r.iter().copied().collect()
+        } else {
+            Vec::new()
+        };
         points.push(Point {
             name: name.to_string(),
             coords,
             rows: rows.iter().copied().collect(),
+            rotations,
         });
     }
     if points.is_empty() {
@@ -174,10 +195,27 @@ pub fn read_basis_npz(path: &Path) -> Result<BasisFile> {
             "no point rows: add arrays 'rows_<name>' of shape (3, p)".to_string(),
         ));
     }
+    let participation = if names.iter().any(|n| n == "participation") {
+        let g: Array2<f64> = npz.by_name("participation").map_err(|e| {
+            npz_err(format!(
+                "key 'participation' must be float64 of shape (3, {p}): {e}"
+            ))
+        })?;
+        if g.shape() != [3, p] {
+            return Err(npz_err(format!(
+                "'participation' has shape {:?}, expected (3, {p}): Φᵀ M r for x, y, z",
+                g.shape()
+            )));
+        }
+        g.iter().copied().collect()
+    } else {
+        Vec::new()
+    };
     let basis = ModalBasis {
         omega: freq.iter().map(|f| f * std::f64::consts::TAU).collect(),
         damping_ratio,
         points,
+        participation,
     };
     basis.validate(&path.display().to_string())?;
     let mut warnings = Vec::new();
@@ -248,11 +286,22 @@ pub fn write_basis_npz(path: &Path, basis: &ModalBasis) -> Result<()> {
         npz.add_array("frequencies_hz", &freq).map_err(e)?;
         npz.add_array("damping_ratio", &Array1::from(basis.damping_ratio.clone()))
             .map_err(e)?;
+        if !basis.participation.is_empty() {
+            let g = Array2::from_shape_vec((3, p), basis.participation.clone())
+                .map_err(|err| std::io::Error::other(err.to_string()))?;
+            npz.add_array("participation", &g).map_err(e)?;
+        }
         for pt in &basis.points {
             let rows = Array2::from_shape_vec((3, p), pt.rows.clone())
                 .map_err(|err| std::io::Error::other(err.to_string()))?;
             npz.add_array(format!("rows_{}", pt.name), &rows)
                 .map_err(e)?;
+            if !pt.rotations.is_empty() {
+                let rot = Array2::from_shape_vec((3, p), pt.rotations.clone())
+                    .map_err(|err| std::io::Error::other(err.to_string()))?;
+                npz.add_array(format!("rotations_{}", pt.name), &rot)
+                    .map_err(e)?;
+            }
             npz.add_array(
                 format!("coords_{}", pt.name),
                 &Array1::from(pt.coords.iter().copied().collect::<Vec<_>>()),

@@ -234,6 +234,9 @@ struct ContactState {
     frame: ContactFrame,
     /// Physical position of the point.
     x: Vector3<f64>,
+    /// Position of the contact point (on the surface for a tube contact) relative to the
+    /// moving obstacle: the penalty law's anchor lives in this frame.
+    x_relative: Vector3<f64>,
     /// Point velocity relative to the obstacle (predicted during the step, full-step after).
     v: Vector3<f64>,
     normal_force: f64,
@@ -244,6 +247,14 @@ struct ContactState {
 }
 
 impl ContactState {
+    /// Contact force on the structure, global axes: `R_N n + T R_T`.
+    fn force(&self) -> Vector3<f64> {
+        let t = &self.frame.tangents;
+        self.frame.normal * self.normal_force
+            + t[0] * self.tangential_force.x
+            + t[1] * self.tangential_force.y
+    }
+
     fn tangential_velocity(&self) -> Vector2<f64> {
         Vector2::new(
             self.frame.tangents[0].dot(&self.v),
@@ -292,6 +303,9 @@ struct Simulation<'m> {
     cd: CentralDifference,
     contacts: Vec<ContactState>,
     tangential: Tangential,
+    /// Rows (3 × p) of the contact points on the tube surface, one block per contact (used
+    /// only by contacts with a radius), updated with the normal at each step.
+    surface_rows: Vec<f64>,
     /// Modal loads `Φ_lᵀ F_l`, one row of p per load.
     load_rows: Vec<f64>,
     external: Vec<f64>,
@@ -318,6 +332,9 @@ impl<'m> Simulation<'m> {
                 &mut load_rows[l * p..(l + 1) * p],
             );
         }
+        if let Some(base) = &model.base_acceleration {
+            load_rows.extend(base.modal_row(&model.basis.participation));
+        }
         let tangential = match settings.method {
             TangentialMethod::Penalty(s) => Tangential::Penalty {
                 settings: s,
@@ -342,6 +359,7 @@ impl<'m> Simulation<'m> {
                 velocity: Vector3::zeros(),
             },
             x: Vector3::zeros(),
+            x_relative: Vector3::zeros(),
             v: Vector3::zeros(),
             normal_force: 0.0,
             tangential_force: Vector2::zeros(),
@@ -354,6 +372,7 @@ impl<'m> Simulation<'m> {
             cd,
             contacts: vec![blank; nc],
             tangential,
+            surface_rows: vec![0.0; 3 * p * nc],
             load_rows,
             external: vec![0.0; p],
             force: vec![0.0; p],
@@ -368,7 +387,7 @@ impl<'m> Simulation<'m> {
     /// t = 0: contacts at the initial state, initial acceleration, first sample.
     fn start(&mut self) {
         self.external_force(0.0);
-        self.detect(false);
+        self.detect(0.0, false);
         self.contact_forces();
         self.cd.start(&self.force);
         for c in &mut self.contacts {
@@ -394,10 +413,10 @@ impl<'m> Simulation<'m> {
         let t = self.step as f64 * self.settings.dt;
         self.cd.predict();
         self.external_force(t);
-        self.detect(true);
+        self.detect(t, true);
         self.contact_forces();
         self.cd.free_acceleration(&self.force);
-        self.lagrange();
+        self.lagrange(t);
         self.cd.correct();
         self.full_step_velocities(false);
 
@@ -436,8 +455,10 @@ impl<'m> Simulation<'m> {
     fn external_force(&mut self, t: f64) {
         let p = self.external.len();
         self.external.iter_mut().for_each(|f| *f = 0.0);
-        for (l, load) in self.model.loads.iter().enumerate() {
-            let s = load.history.value(t);
+        let histories = self.model.loads.iter().map(|l| &l.history);
+        let base = self.model.base_acceleration.iter().map(|b| &b.history);
+        for (l, history) in histories.chain(base).enumerate() {
+            let s = history.value(t);
             for (f, g) in self
                 .external
                 .iter_mut()
@@ -448,24 +469,43 @@ impl<'m> Simulation<'m> {
         }
     }
 
-    /// Step 3: positions, velocities (predicted when `predicted`), frames and normal forces.
-    fn detect(&mut self, predicted: bool) {
+    /// Step 3: positions, velocities (predicted when `predicted`), frames and normal forces
+    /// at time `t`.
+    fn detect(&mut self, t: f64, predicted: bool) {
         let velocity = if predicted {
             &self.cd.qd_star
         } else {
             &self.cd.qd
         };
-        for (c, state) in self.model.contacts.iter().zip(&mut self.contacts) {
+        let p = self.cd.q.len();
+        for (k, (c, state)) in self
+            .model
+            .contacts
+            .iter()
+            .zip(&mut self.contacts)
+            .enumerate()
+        {
             let pt = &self.model.basis.points[c.point];
             state.x = pt.coords + recombine(&pt.rows, &self.cd.q);
-            state.frame = c.frame(&state.x);
+            state.frame = c.frame(&state.x, t);
             state.closed = state.frame.penetration > 0.0;
             state.tangential_force = Vector2::zeros();
             if state.closed {
                 // an open contact's velocity is only needed at output samples
-                state.v = recombine(&pt.rows, velocity) - state.frame.velocity;
+                let rows = if c.at_surface() {
+                    let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
+                    c.surface_rows(pt, &state.frame.normal, out);
+                    &*out
+                } else {
+                    &pt.rows[..]
+                };
+                state.v = recombine(rows, velocity) - state.frame.velocity;
                 let rate = -state.frame.normal.dot(&state.v);
                 state.normal_force = c.normal.force(state.frame.penetration, rate);
+                if matches!(self.tangential, Tangential::Penalty { .. }) {
+                    let (d, _) = c.motion.at(t);
+                    state.x_relative = pt.coords + recombine(rows, &self.cd.q) - d;
+                }
             } else {
                 state.normal_force = 0.0;
             }
@@ -489,7 +529,7 @@ impl<'m> Simulation<'m> {
                         settings,
                         &c.friction,
                         &state.frame.tangents,
-                        &state.x,
+                        &state.x_relative,
                         vt,
                         state.normal_force,
                     );
@@ -499,17 +539,18 @@ impl<'m> Simulation<'m> {
                 }
             }
             if state.closed {
-                let t = &state.frame.tangents;
-                let f = state.frame.normal * state.normal_force
-                    + t[0] * state.tangential_force.x
-                    + t[1] * state.tangential_force.y;
-                project_add(&self.model.basis.points[c.point].rows, &f, &mut self.force);
+                let f = state.force();
+                project_add(
+                    contact_rows(self.model, &self.surface_rows, k),
+                    &f,
+                    &mut self.force,
+                );
             }
         }
     }
 
     /// Step 6 for the Lagrange methods.
-    fn lagrange(&mut self) {
+    fn lagrange(&mut self, t: f64) {
         let Tangential::Lagrange {
             problem,
             solver,
@@ -534,7 +575,7 @@ impl<'m> Simulation<'m> {
                         s_dynamic: c.friction.mu_dynamic * state.normal_force,
                     },
                     &state.frame.tangents,
-                    &self.model.basis.points[c.point].rows,
+                    contact_rows(self.model, &self.surface_rows, k),
                     |l, out| cd.apply_a_inv(l, out),
                 );
             }
@@ -543,13 +584,19 @@ impl<'m> Simulation<'m> {
             history.iter_mut().for_each(|h| h.closed = false);
             return;
         }
-        let contacts = &self.contacts;
+        let (contacts, model, dt) = (&self.contacts, self.model, self.settings.dt);
+        let half_step = self.settings.stick_velocity == StickVelocity::HalfStep;
         problem.assemble(&self.cd.qdd, &self.cd.qd_star, *theta_dt, |slot| {
             let f = &contacts[slot.contact].frame;
-            Vector2::new(
-                f.tangents[0].dot(&f.velocity),
-                f.tangents[1].dot(&f.velocity),
-            )
+            let motion = &model.contacts[slot.contact].motion;
+            // the half-step velocity moves the point from t to t + Δt: the obstacle's velocity
+            // over that step, so that a sticking point keeps its place on the obstacle exactly
+            let v = if half_step && !motion.is_fixed() {
+                (motion.at(t + dt).0 - motion.at(t).0) / dt
+            } else {
+                f.velocity
+            };
+            Vector2::new(f.tangents[0].dot(&v), f.tangents[1].dot(&v))
         });
         let m = problem.len();
         for (k, slot) in problem.slots().iter().enumerate() {
@@ -613,19 +660,33 @@ impl<'m> Simulation<'m> {
 
     /// Full-step velocities `Φ_c q̇_{n+1}` of the closed contacts (of all when `all`).
     fn full_step_velocities(&mut self, all: bool) {
-        for (c, state) in self.model.contacts.iter().zip(&mut self.contacts) {
+        let p = self.cd.q.len();
+        for (k, (c, state)) in self
+            .model
+            .contacts
+            .iter()
+            .zip(&mut self.contacts)
+            .enumerate()
+        {
             if state.closed || all {
                 let pt = &self.model.basis.points[c.point];
-                state.v = recombine(&pt.rows, &self.cd.qd) - state.frame.velocity;
+                if c.at_surface() && !state.closed {
+                    let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
+                    c.surface_rows(pt, &state.frame.normal, out);
+                }
+                let rows = contact_rows(self.model, &self.surface_rows, k);
+                state.v = recombine(rows, &self.cd.qd) - state.frame.velocity;
             }
         }
     }
 
-    /// Energy `E` and the powers `[external, modal damping, contact damping, tangential]`.
+    /// Energy `E` and the powers `[external (loads and moving obstacles), modal damping,
+    /// contact damping, tangential]`.
     fn energy_and_powers(&self) -> (f64, [f64; 4]) {
         let mut e = self.cd.energy();
         let mut contact_damping = 0.0;
         let mut tangential = 0.0;
+        let mut obstacle = 0.0;
         for (c, s) in self.model.contacts.iter().zip(&self.contacts) {
             if s.closed {
                 let d = s.frame.penetration;
@@ -633,9 +694,11 @@ impl<'m> Simulation<'m> {
                 let rate = -s.frame.normal.dot(&s.v);
                 contact_damping += (s.normal_force - c.normal.stiffness * d) * rate;
                 tangential -= s.tangential_force.dot(&s.tangential_velocity());
+                // a moving obstacle works on the structure at the rate R·v_obstacle
+                obstacle += s.force().dot(&s.frame.velocity);
             }
         }
-        let external = dot(&self.external, &self.cd.qd);
+        let external = dot(&self.external, &self.cd.qd) + obstacle;
         (
             e,
             [
@@ -691,6 +754,20 @@ impl<'m> Simulation<'m> {
     }
 }
 
+/// Rows (3 × p) through which contact `k` sees the modal coordinates: the point's, or the
+/// surface point's ([`crate::contact::Contact::surface_rows`], updated with the normal by
+/// `detect`). A free function, so that it borrows two fields only.
+#[inline]
+fn contact_rows<'a>(model: &'a Model, surface_rows: &'a [f64], k: usize) -> &'a [f64] {
+    let c = &model.contacts[k];
+    if c.at_surface() {
+        let p = model.basis.modes();
+        &surface_rows[3 * p * k..3 * p * (k + 1)]
+    } else {
+        &model.basis.points[c.point].rows
+    }
+}
+
 impl Tangential {
     fn lagrange(
         model: &Model,
@@ -701,10 +778,14 @@ impl Tangential {
         let nc = model.contacts.len();
         let mut problem = TangentialProblem::new(model.basis.modes(), nc);
         for (k, c) in model.contacts.iter().enumerate() {
-            if let Some(t) = c.obstacle.fixed_tangents() {
-                problem.fix_rows(k, &t, &model.basis.points[c.point].rows, |l, out| {
-                    cd.apply_a_inv(l, out)
-                });
+            if let Some(t) = c.fixed_tangents() {
+                let point = &model.basis.points[c.point];
+                let mut rows = point.rows.clone();
+                if c.at_surface() {
+                    // a plane: the normal never changes
+                    c.surface_rows(point, &c.frame(&point.coords, 0.0).normal, &mut rows);
+                }
+                problem.fix_rows(k, &t, &rows, |l, out| cd.apply_a_inv(l, out));
             }
         }
         Tangential::Lagrange {

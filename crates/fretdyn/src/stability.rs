@@ -31,15 +31,31 @@ pub fn stable_time_step(model: &Model, method: &TangentialMethod) -> f64 {
         _ => (0.0, 0.0),
     };
     for contact in &model.contacts {
-        let rows = &model.basis.points[contact.point].rows;
+        let point = &model.basis.points[contact.point];
         let (normals, tangents) = contact.obstacle.penalty_directions();
-        for n in &normals {
-            add_direction(&mut k, rows, n, contact.normal.stiffness);
-            add_direction(&mut c, rows, n, contact.normal.damping);
+        if !contact.at_surface() {
+            for n in &normals {
+                add_direction(&mut k, &point.rows, n, contact.normal.stiffness);
+                add_direction(&mut c, &point.rows, n, contact.normal.damping);
+            }
+            for ta in &tangents {
+                add_direction(&mut k, &point.rows, ta, kt);
+                add_direction(&mut c, &point.rows, ta, ct);
+            }
+            continue;
         }
-        for ta in &tangents {
-            add_direction(&mut k, rows, ta, kt);
-            add_direction(&mut c, rows, ta, ct);
+        // on the surface the rows depend on the normal: each normal the contact can take (both
+        // senses) with the tangents orthogonal to it (a tangent may be counted more than once:
+        // conservative)
+        let mut rows = point.rows.clone();
+        for n in normals.iter().flat_map(|n| [*n, -n]) {
+            contact.surface_rows(point, &n, &mut rows);
+            add_direction(&mut k, &rows, &n, contact.normal.stiffness);
+            add_direction(&mut c, &rows, &n, contact.normal.damping);
+            for ta in tangents.iter().filter(|ta| ta.dot(&n).abs() < 1e-9) {
+                add_direction(&mut k, &rows, ta, kt);
+                add_direction(&mut c, &rows, ta, ct);
+            }
         }
     }
     let (w2, cmax) = match &model.coordinates {

@@ -99,6 +99,11 @@ impl TubeStructure {
                 omega: modes.omega.clone(),
                 damping_ratio,
                 points,
+                // p × 3, column-major: the 3 × p row-major layout of `participation`
+                participation: (modes.shapes.transpose() * &assembled.base_inertia)
+                    .iter()
+                    .copied()
+                    .collect(),
             },
             assembled,
             modes,
@@ -112,14 +117,17 @@ impl TubeStructure {
         let n = assembled.mass.nrows();
         let points = self.named_points(&assembled, &DMatrix::<f64>::identity(n, n));
         let damping = &assembled.mass * alpha + &assembled.stiffness * beta;
-        Ok(Model::physical(
+        let participation: Vec<f64> = assembled.base_inertia.iter().copied().collect();
+        let mut model = Model::physical(
             PhysicalMatrices {
                 mass: assembled.mass,
                 damping,
                 stiffness: assembled.stiffness,
             },
             points,
-        ))
+        );
+        model.basis.participation = participation;
+        Ok(model)
     }
 }
 
@@ -132,6 +140,7 @@ impl TubeStructure {
                 name: pt.name.clone(),
                 coords: self.beam.mesh.nodes[pt.node] + pt.offset,
                 rows: point_rows(assembled, shapes, pt),
+                rotations: rotation_rows(assembled, shapes, pt.node),
             })
             .collect()
     }
@@ -158,6 +167,20 @@ fn point_rows(assembled: &Assembled, shapes: &DMatrix<f64>, pt: &NamedPoint) -> 
         rows[m] = value(ux, m) + cx;
         rows[p + m] = value(uy, m) + cy;
         rows[2 * p + m] = value(uz, m) + cz;
+    }
+    rows
+}
+
+/// Rotation rows (3 × p) of a node: `θx, θy, θz` of each mode (0 where restrained).
+fn rotation_rows(assembled: &Assembled, shapes: &DMatrix<f64>, node: usize) -> Vec<f64> {
+    let p = shapes.ncols();
+    let mut rows = vec![0.0; 3 * p];
+    for (d, dof) in [Dof::Rx, Dof::Ry, Dof::Rz].into_iter().enumerate() {
+        if let Some(i) = assembled.reduced_index(node, dof) {
+            for m in 0..p {
+                rows[d * p + m] = shapes[(i, m)];
+            }
+        }
     }
     rows
 }

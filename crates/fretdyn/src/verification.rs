@@ -122,17 +122,16 @@ impl V1 {
         let basis = ModalBasis::point_mass(self.mass, "mass", Vector3::zeros())
             .expect("V1 mass is positive");
         let mut model = Model::new(basis);
-        model.contacts.push(Contact {
-            name: "plane".into(),
-            point: 0,
-            obstacle: Obstacle::Plane(
+        model.contacts.push(Contact::new(
+            "plane",
+            0,
+            Obstacle::Plane(
                 Plane::new(Vector3::zeros(), n, 0.0, self.plane_tangent, "v1.plane")
                     .expect("V1 plane is valid"),
             ),
-            normal: NormalLaw::new(self.stiffness, 0.0, "v1.normal").expect("K_N > 0"),
-            friction: Coulomb::new(self.mu_static, self.mu_dynamic, "v1.friction")
-                .expect("μ_s ≥ μ_d ≥ 0"),
-        });
+            NormalLaw::new(self.stiffness, 0.0, "v1.normal").expect("K_N > 0"),
+            Coulomb::new(self.mu_static, self.mu_dynamic, "v1.friction").expect("μ_s ≥ μ_d ≥ 0"),
+        ));
         let v = s * self.tangential_speed() - n * self.normal_speed();
         model
             .set_initial_from_point(0, Vector3::zeros(), v)

@@ -129,6 +129,12 @@ fn point_mass_as_inline_modal_basis_gives_the_same_run() {
          [[structure.points]]\nname = \"mass\"\ncoords = [0.0, 0.0, 0.0]\n\
          rows = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n",
     );
+    // participation factors Φᵀ M r of the unit mass: a point_mass structure computes them
+    let modal = replace_once(
+        &modal,
+        "damping_ratio = 0.0\n",
+        "damping_ratio = 0.0\nparticipation = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n",
+    );
     let a = parse(&text).unwrap();
     let b = parse(&modal).unwrap();
     assert_eq!(a.model, b.model);
@@ -570,7 +576,7 @@ friction = {{ mu = 0.3 }}
     )
     .unwrap();
     // the mass sits on the hole's axis: 0.2 mm of clearance all round
-    let f = c.model.contacts[0].frame(&nalgebra::Vector3::zeros());
+    let f = c.model.contacts[0].frame(&nalgebra::Vector3::zeros(), 0.0);
     assert_eq!(f.penetration, -2e-4);
     assert_eq!(f.tangents[1], nalgebra::Vector3::z());
     let b = Case::from_toml_str(
@@ -578,7 +584,7 @@ friction = {{ mu = 0.3 }}
         Path::new("."),
     )
     .unwrap();
-    let f = b.model.contacts[0].frame(&nalgebra::Vector3::new(0.0, 3e-4, 0.0));
+    let f = b.model.contacts[0].frame(&nalgebra::Vector3::new(0.0, 3e-4, 0.0), 0.0);
     assert!((f.penetration - 2e-4).abs() < 1e-15 && f.normal == -nalgebra::Vector3::y());
     let e = Case::from_toml_str(
         &text(r#"{ type = "circle", centre = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 1.0], clearance = -1.0 }"#),

@@ -76,7 +76,7 @@ fn v1a_is_invariant_under_rotation_of_plane_and_slide_direction() {
     let s = rotated.slide_direction - n * n.dot(&rotated.slide_direction);
     let s = s.normalize();
     let model = rotated.model();
-    let frame = model.contacts[0].frame(&Vector3::zeros());
+    let frame = model.contacts[0].frame(&Vector3::zeros(), 0.0);
     let (plane_normal, t) = (frame.normal, frame.tangents);
     assert!((plane_normal - n).norm() < 1e-15);
     assert!(

@@ -80,15 +80,13 @@ fn add_contacts_and_loads(model: &mut Model) {
         (2, -Vector3::x(), 1e-4, (0.3, 0.3)),
     ];
     for (k, (point, normal, gap, (mu_s, mu_d))) in planes.into_iter().enumerate() {
-        model.contacts.push(Contact {
-            name: format!("c{k}"),
+        model.contacts.push(Contact::new(
+            format!("c{k}"),
             point,
-            obstacle: Obstacle::Plane(
-                Plane::new(Vector3::zeros(), normal, gap, None, "p").unwrap(),
-            ),
-            normal: NormalLaw::new(2e5, 5.0, "n").unwrap(),
-            friction: Coulomb::new(mu_s, mu_d, "f").unwrap(),
-        });
+            Obstacle::Plane(Plane::new(Vector3::zeros(), normal, gap, None, "p").unwrap()),
+            NormalLaw::new(2e5, 5.0, "n").unwrap(),
+            Coulomb::new(mu_s, mu_d, "f").unwrap(),
+        ));
     }
     model.loads.push(
         PointLoad::new(
@@ -113,6 +111,7 @@ fn models() -> (Model, Model, DMatrix<f64>) {
                 name: format!("P{j}"),
                 coords: Vector3::zeros(),
                 rows: rows(j),
+                rotations: Vec::new(),
             })
             .collect()
     };
@@ -142,6 +141,7 @@ fn models() -> (Model, Model, DMatrix<f64>) {
             .collect(),
         omega,
         points: points(&modal_rows),
+        participation: Vec::new(),
     });
     add_contacts_and_loads(&mut physical);
     add_contacts_and_loads(&mut modal);

@@ -732,15 +732,15 @@ fn point_mass_on_plane(mass: f64, kn: f64, gap: f64) -> fretdyn::model::Model {
     use fretdyn::obstacle::{Obstacle, Plane};
     let basis = ModalBasis::point_mass(mass, "m", Vector3::zeros()).unwrap();
     let mut model = fretdyn::model::Model::new(basis);
-    model.contacts.push(Contact {
-        name: "plane".into(),
-        point: 0,
-        obstacle: Obstacle::Plane(
+    model.contacts.push(Contact::new(
+        "plane",
+        0,
+        Obstacle::Plane(
             Plane::new(Vector3::zeros(), Vector3::z(), gap, Some(Vector3::x()), "p").unwrap(),
         ),
-        normal: NormalLaw::new(kn, 0.0, "n").unwrap(),
-        friction: Coulomb::new(0.3, 0.3, "f").unwrap(),
-    });
+        NormalLaw::new(kn, 0.0, "n").unwrap(),
+        Coulomb::new(0.3, 0.3, "f").unwrap(),
+    ));
     model
 }
 
