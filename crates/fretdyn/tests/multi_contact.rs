@@ -880,3 +880,241 @@ fn natural_map_residual_ranks_the_solvers() {
     }
     println!("{}", report.join("\n"));
 }
+
+// ---------------------------------------------------------------------------------------------
+// Brute force: enumerate every stick/slip pattern of a small problem (THEORY §4.2, §4.4).
+// ---------------------------------------------------------------------------------------------
+
+/// One candidate solution of the Coulomb conditions for a fixed stick/slip pattern.
+struct Candidate {
+    lambda: Vec<Vector2<f64>>,
+    pattern: Vec<Slide>,
+    /// How far inside its own admissibility conditions the candidate is (stick: `1 − |λ|/s`,
+    /// slip: `γ / |b|`); negative means it violates them.
+    margin: f64,
+}
+
+/// Solves the pattern's equations, with `w = b − Hλ`:
+/// stick `k`: `w_k = 0` (λ_k free); slip `k`: `λ_k = s_k (cos θ_k, sin θ_k)`,
+/// `w_k = γ_k (cos θ_k, sin θ_k)` (θ_k, γ_k free). 2m equations, 2m unknowns, nonlinear in the
+/// angles only: Newton from a grid of starting angles, each start first made consistent by the
+/// linear solve in (λ_stick, γ) at fixed angles. Returns every distinct converged root.
+fn pattern_roots(hand: &Hand, pattern: &[Slide]) -> Vec<Candidate> {
+    let m = pattern.len();
+    let h = &hand.l * hand.l.transpose();
+    let b = &hand.l * &hand.g;
+    let slips: Vec<usize> = (0..m).filter(|&k| pattern[k] == Slide::Slip).collect();
+    let n = 2 * m;
+    // unknown layout: for stick k: (λ_k,x, λ_k,y) at 2k, 2k+1; for slip k: (θ_k, γ_k) there.
+    let lambda_of = |x: &DVector<f64>| -> DVector<f64> {
+        let mut lam = DVector::zeros(n);
+        for k in 0..m {
+            if pattern[k] == Slide::Stick {
+                lam[2 * k] = x[2 * k];
+                lam[2 * k + 1] = x[2 * k + 1];
+            } else {
+                lam[2 * k] = hand.s[k] * x[2 * k].cos();
+                lam[2 * k + 1] = hand.s[k] * x[2 * k].sin();
+            }
+        }
+        lam
+    };
+    let residual = |x: &DVector<f64>| -> DVector<f64> {
+        let w = &b - &h * lambda_of(x);
+        let mut r = w.clone();
+        for &k in &slips {
+            r[2 * k] -= x[2 * k + 1] * x[2 * k].cos();
+            r[2 * k + 1] -= x[2 * k + 1] * x[2 * k].sin();
+        }
+        r
+    };
+    let jacobian = |x: &DVector<f64>| -> DMatrix<f64> {
+        let mut j = DMatrix::zeros(n, n);
+        for k in 0..m {
+            if pattern[k] == Slide::Stick {
+                for c in 0..2 {
+                    j.set_column(2 * k + c, &(-h.column(2 * k + c)));
+                }
+            } else {
+                let (st, ct) = x[2 * k].sin_cos();
+                let dlam =
+                    h.column(2 * k) * (-hand.s[k] * st) + h.column(2 * k + 1) * (hand.s[k] * ct);
+                let mut col = -dlam;
+                col[2 * k] += x[2 * k + 1] * st;
+                col[2 * k + 1] -= x[2 * k + 1] * ct;
+                j.set_column(2 * k, &col);
+                let mut col = DVector::zeros(n);
+                col[2 * k] = -ct;
+                col[2 * k + 1] = -st;
+                j.set_column(2 * k + 1, &col);
+            }
+        }
+        j
+    };
+    let scale = b.amax();
+    let grid = 12usize;
+    let starts = grid.pow(slips.len() as u32);
+    let mut roots: Vec<Candidate> = Vec::new();
+    for start in 0..starts {
+        let mut x = DVector::zeros(n);
+        let mut idx = start;
+        for &k in &slips {
+            x[2 * k] = 2.0 * std::f64::consts::PI * (idx % grid) as f64 / grid as f64 + 0.1;
+            idx /= grid;
+        }
+        // consistent start: at fixed angles the system is linear in (λ_stick, γ)
+        let r0 = residual(&x);
+        let mut jl = jacobian(&x);
+        for &k in &slips {
+            jl.set_column(2 * k, &DVector::zeros(n));
+        }
+        if let Ok(dx) = jl.svd(true, true).solve(&r0, 1e-12) {
+            x -= dx;
+        }
+        let mut converged = false;
+        for _ in 0..100 {
+            let r = residual(&x);
+            if r.amax() <= 1e-13 * scale {
+                converged = true;
+                break;
+            }
+            let Some(dx) = jacobian(&x).lu().solve(&r) else {
+                break;
+            };
+            x -= dx;
+        }
+        if !converged {
+            continue;
+        }
+        let lam = lambda_of(&x);
+        let lambda: Vec<Vector2<f64>> = (0..m)
+            .map(|k| Vector2::new(lam[2 * k], lam[2 * k + 1]))
+            .collect();
+        let margin = (0..m)
+            .map(|k| match pattern[k] {
+                Slide::Stick => 1.0 - lambda[k].norm() / hand.s[k],
+                Slide::Slip => x[2 * k + 1] / scale,
+            })
+            .fold(f64::INFINITY, f64::min);
+        let same = roots.iter().any(|c| {
+            c.lambda
+                .iter()
+                .zip(&lambda)
+                .all(|(a, b)| (a - b).norm() <= 1e-9 * scale)
+        });
+        if !same {
+            roots.push(Candidate {
+                lambda,
+                pattern: pattern.to_vec(),
+                margin,
+            });
+        }
+    }
+    roots
+}
+
+/// All 2^m patterns; the admissible roots (margin ≥ −tolerance).
+fn brute_force(hand: &Hand) -> Vec<Candidate> {
+    let m = hand.s.len();
+    let mut admissible = Vec::new();
+    for bits in 0..(1usize << m) {
+        let pattern: Vec<Slide> = (0..m)
+            .map(|k| {
+                if bits >> k & 1 == 1 {
+                    Slide::Slip
+                } else {
+                    Slide::Stick
+                }
+            })
+            .collect();
+        admissible.extend(
+            pattern_roots(hand, &pattern)
+                .into_iter()
+                .filter(|c| c.margin >= -1e-10),
+        );
+    }
+    admissible
+}
+
+/// For m = 2 and 3 contacts with μ_s = μ_d (a convex problem with H SPD, so exactly one
+/// solution), enumerating the 2^m stick/slip patterns finds exactly one admissible pattern,
+/// and its forces are those of Gauss–Seidel and of the Active Set. Random problems with
+/// thresholds from 0.02 to 5 times the unconstrained force cover all-stick, all-slip and
+/// mixed solutions (checked).
+#[test]
+fn one_step_problem_brute_force_enumeration_agrees_with_both_solvers() {
+    // FRETDYN_BRUTE_FORCE_CASES=600 for the figures quoted in docs/VERIFICATION.md
+    let cases: u64 = std::env::var("FRETDYN_BRUTE_FORCE_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(90);
+    let mut rng = Lcg(0xb00f);
+    for m in [2usize, 3] {
+        let (mut all_stick, mut all_slip, mut mixed, mut fallbacks) = (0, 0, 0, 0);
+        for case in 0..cases {
+            // thresholds log-uniform in [lo, hi]: above 1 all contacts stick, far below all
+            // slip; every third case of each kind
+            let (lo, hi): (f64, f64) = [(1.05, 5.0), (0.02, 0.3), (0.02, 5.0)][case as usize % 3];
+            let factors: Vec<f64> = (0..m)
+                .map(|_| lo * (hi / lo).powf(0.5 * (rng.next() + 1.0)))
+                .collect();
+            let hand = hand_problem(0xb0_0000 + 100 * m as u64 + case, 2 * m + 2, m, &factors);
+            let label = format!("m = {m}, case {case}, factors {factors:?}");
+            let found = brute_force(&hand);
+            assert!(!found.is_empty(), "{label}: no admissible pattern");
+            // away from the stick/slip boundary exactly one pattern is admissible; on it two
+            // patterns describe the same forces
+            let clear: Vec<&Candidate> = found.iter().filter(|c| c.margin > 1e-6).collect();
+            let degenerate = clear.len() != found.len();
+            if !degenerate {
+                assert_eq!(
+                    found.len(),
+                    1,
+                    "{label}: {} admissible patterns",
+                    found.len()
+                );
+            }
+            let exact = &found[0];
+            for c in &found[1..] {
+                for k in 0..m {
+                    assert!((c.lambda[k] - exact.lambda[k]).norm() <= 1e-8 * hand.s[k].max(1e-300));
+                }
+            }
+            let lg = solve_gs(&hand.problem);
+            let (la, slide_a, outcome, stats) =
+                solve_active_set(&hand.problem, &vec![History::default(); m]);
+            // the Active Set's slip directions are a fixed-point iteration: on strongly coupled
+            // sliding contacts it may need its stated fallback (counted, answer still checked)
+            if !matches!(outcome, Outcome::Converged(_)) {
+                assert_eq!(stats.as_fallbacks, 1, "{label}: {outcome:?} {stats:?}");
+                fallbacks += 1;
+            }
+            let scale = to_dvector(&exact.lambda).norm();
+            for (name, l) in [("Gauss–Seidel", &lg), ("Active Set", &la)] {
+                let diff = (to_dvector(l) - to_dvector(&exact.lambda)).norm();
+                assert!(
+                    diff <= 1e-8 * scale,
+                    "{label}: {name} differs from enumeration by {diff:e}"
+                );
+            }
+            if !degenerate {
+                if matches!(outcome, Outcome::Converged(_)) {
+                    assert_eq!(slide_a, exact.pattern, "{label}: Active Set statuses");
+                }
+                match exact.pattern.iter().filter(|s| **s == Slide::Slip).count() {
+                    0 => all_stick += 1,
+                    n if n == m => all_slip += 1,
+                    _ => mixed += 1,
+                }
+            }
+        }
+        assert!(
+            all_stick >= cases / 6 && all_slip >= cases / 6 && mixed >= cases / 12,
+            "m = {m}: coverage all-stick {all_stick}, all-slip {all_slip}, mixed {mixed}"
+        );
+        println!(
+            "m = {m}: all-stick {all_stick}, all-slip {all_slip}, mixed {mixed}, \
+             Active Set fallbacks {fallbacks}/{cases}"
+        );
+    }
+}
