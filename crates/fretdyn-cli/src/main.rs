@@ -4,6 +4,7 @@ mod bench;
 mod modes;
 mod plot;
 mod progress;
+mod results_plots;
 mod run;
 mod verify;
 
@@ -24,9 +25,17 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Run a case file; without one, run the built-in demo (V1a with the three methods).
+    /// Results are streamed to the output folder; Ctrl-C stops after a checkpoint.
     Run {
         /// Case file (TOML). See examples/ for the reference of every key.
         case: Option<PathBuf>,
+        /// Continue the interrupted (Ctrl-C, killed) run in this folder from its last
+        /// checkpoint; the results are those of an uninterrupted run.
+        #[arg(long, value_name = "DIR")]
+        resume: Option<PathBuf>,
+        /// Wall-clock seconds between checkpoints.
+        #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
+        checkpoint_every: f64,
         /// Output folder [default: fretdyn_results/<case name>].
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -36,6 +45,12 @@ enum Command {
         /// Do not write PNG plots.
         #[arg(long)]
         no_plots: bool,
+    },
+    /// Draw the plots of a run folder again (forces, displacements, orbits in the holes,
+    /// peak-force histograms, wear work rates).
+    Plot {
+        /// Folder written by `fretdyn run`.
+        dir: PathBuf,
     },
     /// Run V1a, V1b, V1c (THEORY §6) with every method, compare with the analytic solution,
     /// write the figures; exit code 1 if a check fails.
@@ -90,10 +105,36 @@ fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Run {
             case,
+            resume,
+            checkpoint_every,
             output,
             quiet,
             no_plots,
-        } => run::main(case.as_deref(), output, quiet, !no_plots),
+        } => {
+            // Ctrl-C: stop at the next progress report, after a checkpoint (a second Ctrl-C
+            // while stopping is ignored: the files are being closed)
+            let _ = ctrlc::set_handler(|| {
+                run::INTERRUPTED.store(true, std::sync::atomic::Ordering::Relaxed)
+            });
+            let options = run::Options {
+                output,
+                quiet,
+                plots: !no_plots,
+                checkpoint_seconds: checkpoint_every,
+            };
+            if !(checkpoint_every.is_finite() && checkpoint_every > 0.0) {
+                Err(Failure::input(format!(
+                    "--checkpoint-every: must be a positive number of seconds (got {checkpoint_every})"
+                )))
+            } else {
+                run::main(case.as_deref(), resume.as_deref(), &options)
+            }
+        }
+        Command::Plot { dir } => results_plots::plot_run(&dir).map(|files| {
+            for f in files {
+                println!("wrote {}", f.display());
+            }
+        }),
         Command::Verify { output, quiet } => verify::main(&output, quiet),
         Command::Modes {
             case,

@@ -141,6 +141,148 @@ fn panels(
     Ok(())
 }
 
+/// Square panels of y against x with equal scales (orbits), two per row; in each panel the
+/// last series (the outline) is drawn in black.
+pub fn xy_panels(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    panels: &[(String, Vec<Series>)],
+) -> Result<(), String> {
+    register_font();
+    let err = |e: &dyn std::fmt::Display| format!("{}: cannot draw the plot: {e}", path.display());
+    let columns = panels.len().clamp(1, 2);
+    let rows = panels.len().div_ceil(columns).max(1);
+    let side = WIDTH / columns as u32;
+    let root = BitMapBackend::new(path, (WIDTH, 40 + side * rows as u32)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let root = root
+        .titled(title, ("sans-serif", 22))
+        .map_err(|e| err(&e))?;
+    let areas = root.split_evenly((rows, columns));
+    for ((panel_title, series), area) in panels.iter().zip(areas) {
+        let (xr, yr) = ranges(series);
+        // equal scales: the larger half-span on both axes, about the centre
+        let half = 0.5 * (xr.end - xr.start).max(yr.end - yr.start);
+        let (cx, cy) = (0.5 * (xr.start + xr.end), 0.5 * (yr.start + yr.end));
+        let mut chart = ChartBuilder::on(&area)
+            .caption(panel_title.as_str(), ("sans-serif", 16))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(80)
+            .build_cartesian_2d(cx - half..cx + half, cy - half..cy + half)
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .x_labels(6)
+            .y_labels(6)
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .draw()
+            .map_err(|e| err(&e))?;
+        for (k, s) in series.iter().enumerate() {
+            let outline = k + 1 == series.len();
+            let colour = if outline {
+                BLACK
+            } else {
+                COLOURS[k % COLOURS.len()]
+            };
+            let style = colour.stroke_width(1);
+            let n = s.x.len().min(s.y.len());
+            // at most 20 000 points of the orbit, evenly taken
+            let stride = n.div_ceil(20_000).max(1);
+            let points = (0..n).step_by(stride).map(|i| (s.x[i], s.y[i]));
+            chart
+                .draw_series(LineSeries::new(points, style))
+                .map_err(|e| err(&e))?
+                .label(s.label.clone())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| err(&e))?;
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// One bar: its label (on the x axis) and value.
+pub struct Bar {
+    pub label: String,
+    pub value: f64,
+}
+
+/// Stacked panels of bar charts, one per entry (panel title, bars); 300 px each.
+pub fn bar_panels(
+    path: &Path,
+    title: &str,
+    y_label: &str,
+    panels: &[(String, Vec<Bar>)],
+) -> Result<(), String> {
+    register_font();
+    let err = |e: &dyn std::fmt::Display| format!("{}: cannot draw the plot: {e}", path.display());
+    let height = 60 + 300 * panels.len().max(1) as u32;
+    let root = BitMapBackend::new(path, (WIDTH, height)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let root = root
+        .titled(title, ("sans-serif", 22))
+        .map_err(|e| err(&e))?;
+    let areas = root.split_evenly((panels.len().max(1), 1));
+    for ((panel_title, bars), area) in panels.iter().zip(areas) {
+        let n = bars.len().max(1);
+        let top = bars
+            .iter()
+            .map(|b| b.value)
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        let top = if top > 0.0 { 1.1 * top } else { 1.0 };
+        let mut chart = ChartBuilder::on(&area)
+            .caption(panel_title.as_str(), ("sans-serif", 16))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(80)
+            .build_cartesian_2d((0..n).into_segmented(), 0.0..top)
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(n)
+            .x_label_formatter(&|v| match v {
+                SegmentValue::CenterOf(i) => {
+                    bars.get(*i).map(|b| b.label.clone()).unwrap_or_default()
+                }
+                _ => String::new(),
+            })
+            .y_desc(y_label)
+            .y_label_formatter(&|v| tick(*v))
+            .draw()
+            .map_err(|e| err(&e))?;
+        chart
+            .draw_series(bars.iter().enumerate().map(|(i, b)| {
+                let v = if b.value.is_finite() { b.value } else { 0.0 };
+                let mut bar = Rectangle::new(
+                    [
+                        (SegmentValue::Exact(i), 0.0),
+                        (SegmentValue::Exact(i + 1), v),
+                    ],
+                    COLOURS[0].filled(),
+                );
+                bar.set_margin(0, 0, 6, 6);
+                bar
+            }))
+            .map_err(|e| err(&e))?;
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
 /// Tick label: plain for moderate magnitudes, scientific otherwise.
 fn tick(v: f64) -> String {
     let a = v.abs();

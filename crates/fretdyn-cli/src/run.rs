@@ -1,35 +1,126 @@
-//! `fretdyn run`: one case file, or the built-in demo.
+//! `fretdyn run`: one case file, or the built-in demo; `fretdyn run --resume DIR` continues a
+//! run that was interrupted; `fretdyn plot DIR` redraws a run's plots.
+//!
+//! Every run is streamed to its folder ([`fretdyn::stream`]): time histories flushed chunk by
+//! chunk, impacts as they end, a checkpoint every `checkpoint_seconds` and on Ctrl-C, so that
+//! a killed run leaves readable results and can be resumed, giving the results of an
+//! uninterrupted run bit for bit.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use fretdyn::case::Case;
-use fretdyn::simulation::{RunResults, Termination, run};
+use fretdyn::simulation::{Progress, RunResults, Termination};
+use fretdyn::stream::{StreamObserver, StreamSettings};
 use fretdyn::verification::V1;
+use ndarray::{Array3, Ix3};
+use ndarray_npy::NpzReader;
+use serde_json::json;
 
 use crate::Failure;
-use crate::plot::{Series, line_plot, panels_plot};
+use crate::plot::{Series, line_plot};
 use crate::progress::Bar;
 
+/// Set by Ctrl-C: the run stops at its next progress report, after a checkpoint.
+pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// The file that records which case a run folder belongs to, for `--resume`.
+const RUN_FILE: &str = "run.json";
+
+/// Options of `fretdyn run`.
+pub struct Options {
+    pub output: Option<PathBuf>,
+    pub quiet: bool,
+    pub plots: bool,
+    /// Wall-clock seconds between checkpoints.
+    pub checkpoint_seconds: f64,
+}
+
 /// Entry point of `fretdyn run`.
-pub fn main(
-    case: Option<&Path>,
-    output: Option<PathBuf>,
-    quiet: bool,
-    plots: bool,
-) -> Result<(), Failure> {
-    match case {
-        Some(path) => {
-            let case = Case::from_file(path)
+pub fn main(case: Option<&Path>, resume: Option<&Path>, options: &Options) -> Result<(), Failure> {
+    match (case, resume) {
+        (Some(_), Some(_)) => Err(Failure::input(
+            "give either a case file or --resume DIR (the folder knows its case file)",
+        )),
+        (None, Some(dir)) => resume_run(dir, options),
+        (Some(path), None) => {
+            let case = load(path)?;
+            let dir = options
+                .output
+                .clone()
+                .unwrap_or_else(|| default_dir(&case.title, path));
+            let fingerprint = fingerprint_of(path)?;
+            // bad input is refused before anything is written
+            fretdyn::simulation::Simulation::check(&case.model, &case.settings)
                 .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
-            for w in &case.warnings {
-                eprintln!("warning: {w}");
-            }
-            let dir = output.unwrap_or_else(|| default_dir(&case.title, path));
-            run_and_write(&case, &path.display().to_string(), &dir, quiet, plots)?;
+            std::fs::create_dir_all(&dir).map_err(|e| {
+                Failure::failed(format!("{}: cannot create the folder: {e}", dir.display()))
+            })?;
+            let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+            let run_file = json!({ "case_file": absolute, "fingerprint": fingerprint.to_string() });
+            std::fs::write(dir.join(RUN_FILE), format!("{run_file:#}\n"))
+                .map_err(|e| Failure::failed(format!("{}: {e}", dir.join(RUN_FILE).display())))?;
+            run_and_write(
+                &case,
+                &path.display().to_string(),
+                &dir,
+                options,
+                fingerprint,
+                false,
+            )?;
             Ok(())
         }
-        None => demo(output, quiet, plots),
+        (None, None) => demo(options),
     }
+}
+
+fn load(path: &Path) -> Result<Case, Failure> {
+    let case =
+        Case::from_file(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+    for w in &case.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(case)
+}
+
+/// Hash of the case file's text: a resumed run must use the case it started with.
+fn fingerprint_of(path: &Path) -> Result<u64, Failure> {
+    let bytes =
+        std::fs::read(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+    Ok(fretdyn::stream::fnv1a(&bytes))
+}
+
+fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
+    let run_file = dir.join(RUN_FILE);
+    let info: serde_json::Value = std::fs::read_to_string(&run_file)
+        .map_err(|e| e.to_string())
+        .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+        .map_err(|e| {
+            Failure::input(format!(
+                "{}: {e} (--resume needs a folder written by fretdyn run CASE)",
+                run_file.display()
+            ))
+        })?;
+    let path = PathBuf::from(info["case_file"].as_str().unwrap_or_default());
+    let case = load(&path)?;
+    let fingerprint = fingerprint_of(&path)?;
+    if info["fingerprint"].as_str() != Some(fingerprint.to_string().as_str()) {
+        return Err(Failure::input(format!(
+            "{}: the case file changed since the run in {} started; start the run again instead of resuming it",
+            path.display(),
+            dir.display()
+        )));
+    }
+    run_and_write(
+        &case,
+        &path.display().to_string(),
+        dir,
+        options,
+        fingerprint,
+        true,
+    )?;
+    Ok(())
 }
 
 fn default_dir(title: &str, path: &Path) -> PathBuf {
@@ -40,25 +131,82 @@ fn default_dir(title: &str, path: &Path) -> PathBuf {
     PathBuf::from("fretdyn_results").join(stem)
 }
 
-/// Runs a case, writes `results.npz`, `summary.json` and plots in `dir`, prints a report.
-/// A diverged run still writes what it computed, then fails with the step and contact.
+/// Progress bar, Ctrl-C, and `summary.json` rewritten at each checkpoint.
+struct Observer<'a> {
+    bar: Bar,
+    case: &'a Case,
+    dir: &'a Path,
+}
+
+impl StreamObserver for Observer<'_> {
+    fn progress(&mut self, p: Progress) -> ControlFlow<()> {
+        let _ = self.bar.observe(p);
+        if INTERRUPTED.load(Ordering::Relaxed) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+
+    fn checkpoint(&mut self, partial: &RunResults) {
+        let summary = fretdyn::output::summary(self.case, partial);
+        // a failure here is reported by the final write
+        let _ = fretdyn::output::write_summary(self.dir, &summary);
+    }
+}
+
+/// Runs (or resumes) a case streamed into `dir`, writes `summary.json` and the plots, prints
+/// a report. A diverged or interrupted run keeps what it wrote, then fails with the step
+/// (and contact).
 pub fn run_and_write(
     case: &Case,
     source: &str,
     dir: &Path,
-    quiet: bool,
-    plots: bool,
+    options: &Options,
+    fingerprint: u64,
+    resume: bool,
 ) -> Result<RunResults, Failure> {
-    let mut bar = Bar::new(&case.title, !quiet);
-    let results = run(&case.model, &case.settings, |p| bar.observe(p))
-        .map_err(|e| Failure::input(format!("{source}: {e}")))?;
-    bar.finish();
-    write_outputs(dir, case, &results, plots)?;
-    if !quiet {
+    let stream = StreamSettings {
+        checkpoint_every_seconds: Some(options.checkpoint_seconds),
+        ..StreamSettings::default()
+    };
+    let mut observer = Observer {
+        bar: Bar::new(&case.title, !options.quiet),
+        case,
+        dir,
+    };
+    let results = if resume {
+        fretdyn::stream::resume(
+            &case.model,
+            &case.settings,
+            dir,
+            &stream,
+            fingerprint,
+            &mut observer,
+        )
+    } else {
+        fretdyn::stream::run(
+            &case.model,
+            &case.settings,
+            dir,
+            &stream,
+            fingerprint,
+            &mut observer,
+        )
+    }
+    .map_err(|e| Failure::input(format!("{source}: {e}")))?;
+    observer.bar.finish();
+    let io = |e: fretdyn::Error| Failure::failed(e.to_string());
+    let summary = fretdyn::output::summary(case, &results);
+    fretdyn::output::write_summary(dir, &summary).map_err(io)?;
+    if options.plots {
+        crate::results_plots::plot_run(dir)?;
+    }
+    if !options.quiet {
         report(case, &results, dir);
     }
     match &results.termination {
-        Termination::Completed => Ok(results),
+        Termination::Completed | Termination::InProgress { .. } => Ok(results),
         Termination::Diverged {
             step,
             time,
@@ -72,85 +220,24 @@ pub fn run_and_write(
             dir.display()
         ))),
         Termination::Stopped { step } => Err(Failure::failed(format!(
-            "{source}: stopped at step {step}; the results up to then are in {}",
+            "{source}: interrupted at step {step}; the results up to then are in {}; continue it with: fretdyn run --resume {}",
+            dir.display(),
             dir.display()
         ))),
     }
 }
 
-/// Writes every output of a run into `dir`.
-pub fn write_outputs(
-    dir: &Path,
-    case: &Case,
-    results: &RunResults,
-    plots: bool,
-) -> Result<(), Failure> {
-    std::fs::create_dir_all(dir).map_err(|e| {
-        Failure::failed(format!("{}: cannot create the folder: {e}", dir.display()))
-    })?;
-    let io = |e: fretdyn::Error| Failure::failed(e.to_string());
-    fretdyn::output::write_results_npz(dir, results).map_err(io)?;
-    let summary = fretdyn::output::summary(case, results);
-    fretdyn::output::write_summary(dir, &summary).map_err(io)?;
-    if plots && !case.model.contacts.is_empty() {
-        plot_contact_forces(&dir.join("contact_forces.png"), case, results)
-            .map_err(Failure::failed)?;
-    }
-    Ok(())
-}
-
-/// Contact forces against time, one panel per contact.
-fn plot_contact_forces(path: &Path, case: &Case, results: &RunResults) -> Result<(), String> {
-    let r = &results.recorder;
-    let t: Vec<f64> = r.t.to_vec();
-    let columns: Vec<[Vec<f64>; 3]> = (0..case.model.contacts.len())
-        .map(|k| {
-            [
-                r.normal_force.column(k).to_vec(),
-                r.tangential_force.slice(ndarray::s![.., k, 0]).to_vec(),
-                r.tangential_force.slice(ndarray::s![.., k, 1]).to_vec(),
-            ]
-        })
-        .collect();
-    let panels: Vec<(String, Vec<Series>)> = case
-        .model
-        .contacts
-        .iter()
-        .zip(&columns)
-        .map(|(c, [n, t1, t2])| {
-            (
-                c.name.clone(),
-                vec![
-                    Series {
-                        label: "normal R_N".into(),
-                        x: &t,
-                        y: n,
-                    },
-                    Series {
-                        label: "tangential R_T,1".into(),
-                        x: &t,
-                        y: t1,
-                    },
-                    Series {
-                        label: "tangential R_T,2".into(),
-                        x: &t,
-                        y: t2,
-                    },
-                ],
-            )
-        })
-        .collect();
-    panels_plot(
-        path,
-        &format!(
-            "{} — contact forces ({})",
-            case.title,
-            case.settings.method.name()
-        ),
-        "t (s)",
-        "force (N)",
-        &panels,
-    )
+/// Reads `t` and `contact_tangential_force` of a finished run.
+fn read_friction(dir: &Path) -> Result<(Vec<f64>, Array3<f64>), Failure> {
+    let path = dir.join(fretdyn::stream::RESULTS_FILE);
+    let err = |e: &dyn std::fmt::Display| Failure::failed(format!("{}: {e}", path.display()));
+    let file = std::fs::File::open(&path).map_err(|e| err(&e))?;
+    let mut npz = NpzReader::new(file).map_err(|e| err(&e))?;
+    let t: ndarray::Array1<f64> = npz.by_name("t.npy").map_err(|e| err(&e))?;
+    let f = npz
+        .by_name::<_, Ix3>("contact_tangential_force.npy")
+        .map_err(|e| err(&e))?;
+    Ok((t.to_vec(), f))
 }
 
 fn report(case: &Case, r: &RunResults, dir: &Path) {
@@ -205,8 +292,12 @@ fn report(case: &Case, r: &RunResults, dir: &Path) {
 
 /// The built-in demo: V1a (THEORY §6) with the Active Set, the Gauss–Seidel and the penalty
 /// method (K_T = 1e6 N/m, C_T = 2000 N·s/m), and a plot comparing their friction forces.
-fn demo(output: Option<PathBuf>, quiet: bool, plots: bool) -> Result<(), Failure> {
-    let dir = output.unwrap_or_else(|| PathBuf::from("fretdyn_results").join("demo_v1a"));
+fn demo(options: &Options) -> Result<(), Failure> {
+    let (quiet, plots) = (options.quiet, options.plots);
+    let dir = options
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("fretdyn_results").join("demo_v1a"));
     let v1 = V1::reference(20.0);
     if !quiet {
         println!(
@@ -217,12 +308,17 @@ fn demo(output: Option<PathBuf>, quiet: bool, plots: bool) -> Result<(), Failure
     for (label, method) in fretdyn::verification::methods(&[1e6]) {
         let slug = label.split_whitespace().next().unwrap_or("run").to_string();
         let case = v1.case(&format!("V1a {label}"), method);
-        let results = run_and_write(&case, "demo", &dir.join(&slug), quiet, plots)?;
-        let r = &results.recorder;
-        let magnitude: Vec<f64> = (0..r.len())
-            .map(|i| r.tangential_force[[i, 0, 0]].hypot(r.tangential_force[[i, 0, 1]]))
+        let sub = dir.join(&slug);
+        std::fs::create_dir_all(&sub).map_err(|e| {
+            Failure::failed(format!("{}: cannot create the folder: {e}", sub.display()))
+        })?;
+        let fingerprint = fretdyn::stream::fnv1a(case.title.as_bytes());
+        run_and_write(&case, "demo", &sub, options, fingerprint, false)?;
+        let (t, f) = read_friction(&sub)?;
+        let magnitude: Vec<f64> = (0..t.len())
+            .map(|i| f[[i, 0, 0]].hypot(f[[i, 0, 1]]))
             .collect();
-        curves.push((label, r.t.to_vec(), magnitude));
+        curves.push((label, t, magnitude));
     }
     if plots {
         let t = curves[0].1.clone();

@@ -276,3 +276,123 @@ fn modes_prints_the_table_and_writes_basis_and_picture() {
     assert_eq!(back.basis.modes(), 12);
     assert_eq!(back.basis.points.len(), 2);
 }
+
+/// Step of the last checkpoint in a run folder (`checkpoint.bin`: version u32, fingerprint
+/// u64, then the snapshot, whose first field is the step, u64 little-endian).
+fn checkpoint_step(dir: &Path) -> Option<u64> {
+    let bytes = std::fs::read(dir.join("checkpoint.bin")).ok()?;
+    Some(u64::from_le_bytes(bytes.get(12..20)?.try_into().ok()?))
+}
+
+fn npz_f64(dir: &Path, key: &str) -> ndarray::ArrayD<f64> {
+    let mut npz =
+        ndarray_npy::NpzReader::new(std::fs::File::open(dir.join("results.npz")).unwrap()).unwrap();
+    npz.by_name(key).unwrap()
+}
+
+/// The tube in its 5 plates under turbulence, 10 simulated seconds: run to the end; run again
+/// and `kill -9` it past half time; what it wrote is readable; `run --resume` finishes it with
+/// the results of the uninterrupted run, bit for bit.
+#[test]
+fn turbulence_tube_killed_at_half_time_resumes_bit_for_bit() {
+    let s = Scratch::new("resume");
+    let case = examples().join("tube_turbulence.toml");
+    let case = case.to_str().unwrap();
+    let out = fretdyn(&["run", case, "-o", "full", "-q", "--no-plots"], &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let full = s.0.join("full");
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args([
+            "run",
+            case,
+            "-o",
+            "killed",
+            "-q",
+            "--no-plots",
+            "--checkpoint-every",
+            "0.2",
+        ])
+        .current_dir(&s.0)
+        .spawn()
+        .unwrap();
+    let killed = s.0.join("killed");
+    let start = std::time::Instant::now();
+    while checkpoint_step(&killed).is_none_or(|n| n < 500_000) {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before it could be killed"
+        );
+        assert!(
+            start.elapsed().as_secs() < 600,
+            "no checkpoint past half time"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    Command::new("kill")
+        .args(["-9", &child.id().to_string()])
+        .status()
+        .unwrap();
+    child.wait().unwrap();
+    // readable up to the last flush: every series has the rows its header says
+    let t: ndarray::Array1<f64> = ndarray_npy::ReadNpyExt::read_npy(
+        std::fs::File::open(killed.join("series/t.npy")).unwrap(),
+    )
+    .unwrap();
+    assert!(t.len() > 1000 && t.iter().all(|v| v.is_finite()));
+    assert!(!killed.join("results.npz").exists());
+
+    let out = fretdyn(&["run", "--resume", "killed", "-q", "--no-plots"], &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for key in [
+        "t",
+        "q",
+        "qdot",
+        "contact_normal_force",
+        "contact_tangential_force",
+        "contact_slip_velocity",
+        "contact_penetration",
+        "contact_position",
+    ] {
+        let (a, b) = (npz_f64(&full, key), npz_f64(&killed, key));
+        assert_eq!(a.shape(), b.shape(), "{key}");
+        // bit for bit
+        assert!(
+            a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+            "{key} differs"
+        );
+    }
+    for file in ["impacts.csv", "blocks.csv"] {
+        let (a, b) = (
+            std::fs::read_to_string(full.join(file)).unwrap(),
+            std::fs::read_to_string(killed.join(file)).unwrap(),
+        );
+        assert!(a.lines().count() > 20, "{file} has content");
+        assert_eq!(a, b, "{file}");
+    }
+    let summary = |d: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap()
+    };
+    let (a, b) = (summary(&full), summary(&killed));
+    for key in [
+        "contacts",
+        "energy_balance",
+        "solver",
+        "termination",
+        "time",
+    ] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+    // resuming a finished run is refused
+    let out = fretdyn(&["run", "--resume", "killed", "-q", "--no-plots"], &s.0);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nothing to resume"));
+}

@@ -107,6 +107,7 @@ pub fn rattling_tube(modes: usize, contacts: usize, method: TangentialMethod, st
             method,
             stick_velocity: StickVelocity::HalfStep,
             output_every: 100,
+            statistics: Default::default(),
         },
     )
 }

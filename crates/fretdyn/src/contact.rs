@@ -105,6 +105,17 @@ impl Contact {
         frame
     }
 
+    /// Position of the point relative to the obstacle at time `t`
+    /// ([`Obstacle::local`] of `x − d(t)`).
+    #[inline]
+    pub fn local(&self, x: &Vector3<f64>, t: f64) -> nalgebra::Vector2<f64> {
+        if self.motion.is_fixed() {
+            self.obstacle.local(x)
+        } else {
+            self.obstacle.local(&(x - self.motion.at(t).0))
+        }
+    }
+
     /// True when the contact is on the tube surface rather than at the point.
     #[inline]
     pub fn at_surface(&self) -> bool {

@@ -43,7 +43,7 @@ impl Coulomb {
 }
 
 /// Stick or slip, as decided by a local solve.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Slide {
     /// Inside the static disk: the tangential velocity is zero.
     Stick,

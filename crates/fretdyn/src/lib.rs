@@ -9,9 +9,10 @@
 //! Data flow, one module per concept:
 //! [`case`] (TOML; a [`tube`] is meshed with [`beam`] elements and reduced by [`eigen`]) →
 //! [`model`] ([`modal`] basis, [`contact`]s with their [`obstacle`] and
-//! [`friction`], [`load`]s) → [`simulation`] ([`central_difference`] steps, normal penalty,
-//! [`tangential`] methods on the [`delassus`] problem) → [`recorder`] and [`statistics`] →
-//! [`output`] (`results.npz`, `summary.json`).
+//! [`friction`], [`load`]s and [`turbulence`]) → [`simulation`] ([`central_difference`]
+//! steps, normal penalty, [`tangential`] methods on the [`delassus`] problem) → [`recorder`]
+//! and [`statistics`] → [`output`] (`results.npz`, `summary.json`) and [`stream`] (long runs
+//! streamed to disk, checkpoints, resume).
 //!
 //! ```no_run
 //! let case = fretdyn::case::Case::from_file("examples/v1a_oblique_impact.toml".as_ref())?;
@@ -42,8 +43,10 @@ pub mod recorder;
 pub mod simulation;
 pub mod stability;
 pub mod statistics;
+pub mod stream;
 pub mod tangential;
 pub mod tube;
+pub mod turbulence;
 pub mod verification;
 
 pub use error::{Error, Result};

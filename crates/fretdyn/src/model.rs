@@ -3,7 +3,7 @@
 
 use crate::contact::Contact;
 use crate::error::{Error, Result};
-use crate::load::{BaseAcceleration, PointLoad};
+use crate::load::{BaseAcceleration, ModalLoad, PointLoad};
 use crate::modal::ModalBasis;
 
 /// Initial modal state `q(0)`, `q̇(0)`.
@@ -52,6 +52,10 @@ pub struct Model {
     pub contacts: Vec<Contact>,
     /// Point loads.
     pub loads: Vec<PointLoad>,
+    /// Loads given on the modes (modal forces, line loads along a tube).
+    pub modal_loads: Vec<ModalLoad>,
+    /// Random turbulence loads.
+    pub turbulence: Vec<crate::load::TurbulentLoad>,
     /// Uniform acceleration of the base, if any (displacements are then relative to it).
     pub base_acceleration: Option<BaseAcceleration>,
     /// Initial state.
@@ -67,6 +71,8 @@ impl Model {
             coordinates: Coordinates::Modal,
             contacts: Vec::new(),
             loads: Vec::new(),
+            modal_loads: Vec::new(),
+            turbulence: Vec::new(),
             base_acceleration: None,
             initial: InitialState {
                 q: vec![0.0; p],
@@ -130,6 +136,17 @@ impl Model {
                     "refers to no point of the structure",
                 ));
             }
+        }
+        for (k, l) in self.modal_loads.iter().enumerate() {
+            if l.row.len() != p {
+                return Err(Error::invalid(
+                    format!("modal_loads[{k}].force"),
+                    format!("must have one value per mode ({p}), got {}", l.row.len()),
+                ));
+            }
+        }
+        for (k, l) in self.turbulence.iter().enumerate() {
+            l.validate(p, &format!("turbulence[{k}]"))?;
         }
         if self.base_acceleration.is_some() && self.basis.participation.is_empty() {
             return Err(Error::invalid(

@@ -6,7 +6,7 @@ use nalgebra::{Vector2, Vector3};
 use crate::error::{Error, Result};
 
 /// What a contact needs from the obstacle at one instant.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactFrame {
     /// Penetration `δ` (m): positive when the point is past the obstacle surface, negative is
     /// the remaining clearance.
@@ -397,6 +397,71 @@ impl Obstacle {
             Obstacle::BiPlane(b) => b.frame(x),
             Obstacle::Polygon(p) => p.frame(x),
         }
+    }
+
+    /// Where the point is relative to the obstacle, for the displacement statistics and the
+    /// orbit plots (THEORY §5): for a hole, the in-plane offset `(r·e1, r·e2)` of the point
+    /// from the hole's centre; for a plane or bars, `((x − x0)·n, (x − x0)·t1)`, the distance
+    /// from the plane through `x0` (the bars' mid-plane) and the position along `t1`.
+    pub fn local(&self, x: &Vector3<f64>) -> Vector2<f64> {
+        match self {
+            Obstacle::Plane(p) => {
+                let d = x - p.origin;
+                Vector2::new(d.dot(&p.normal), d.dot(&p.tangents[0]))
+            }
+            Obstacle::BiPlane(b) => {
+                let d = x - b.origin;
+                Vector2::new(d.dot(&b.normal), d.dot(&b.tangents[0]))
+            }
+            Obstacle::Circle(c) => {
+                let d = x - c.centre;
+                let e2 = c.axis.cross(&c.e1);
+                Vector2::new(d.dot(&c.e1), d.dot(&e2))
+            }
+            Obstacle::Polygon(p) => {
+                let d = x - p.centre;
+                Vector2::new(d.dot(&p.e1), d.dot(&p.e2))
+            }
+        }
+    }
+
+    /// Name of the obstacle's type, as in case files.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Obstacle::Plane(_) => "plane",
+            Obstacle::Circle(_) => "circle",
+            Obstacle::BiPlane(_) => "bi_plane",
+            Obstacle::Polygon(_) => "polygon",
+        }
+    }
+
+    /// The boundary of a hole in its [`local`](Self::local) axes (closed: the last point is
+    /// the first), for orbit plots; `None` for planes and bars.
+    pub fn outline(&self) -> Option<Vec<[f64; 2]>> {
+        match self {
+            Obstacle::Circle(c) => Some(
+                (0..=180)
+                    .map(|k| {
+                        let a = std::f64::consts::TAU * k as f64 / 180.0;
+                        [c.clearance * a.cos(), c.clearance * a.sin()]
+                    })
+                    .collect(),
+            ),
+            Obstacle::Polygon(p) => Some(
+                p.vertices
+                    .iter()
+                    .chain(p.vertices.first())
+                    .map(|v| [v.x, v.y])
+                    .collect(),
+            ),
+            Obstacle::Plane(_) | Obstacle::BiPlane(_) => None,
+        }
+    }
+
+    /// True for holes (circle, polygon): their [`local`](Self::local) position is an
+    /// in-plane offset whose radius and angle are meaningful.
+    pub fn is_hole(&self) -> bool {
+        matches!(self, Obstacle::Circle(_) | Obstacle::Polygon(_))
     }
 
     /// The tangent basis, when it does not depend on the position or time (fixed planes and

@@ -30,8 +30,9 @@ use crate::simulation::RunResults;
 
 /// Writes `results.npz` in `dir` with the arrays of [`crate::recorder::Recorder`]:
 /// `t`, `q`, `qdot`, `contact_normal_force`, `contact_tangential_force`,
-/// `contact_slip_velocity`, `contact_penetration`, `contact_status`, and `contact_names`
-/// is not stored (names are in `summary.json`, in the same order).
+/// `contact_slip_velocity`, `contact_penetration`, `contact_status`, `contact_position`
+/// (contact names are in `summary.json`, in the same order). A streamed run
+/// ([`crate::stream`]) writes the same keys.
 pub fn write_results_npz(dir: &Path, results: &RunResults) -> Result<PathBuf> {
     let r = &results.recorder;
     let path = dir.join("results.npz");
@@ -50,6 +51,7 @@ pub fn write_results_npz(dir: &Path, results: &RunResults) -> Result<PathBuf> {
         npz.add_array("contact_penetration", &r.penetration)
             .map_err(e)?;
         npz.add_array("contact_status", &r.status).map_err(e)?;
+        npz.add_array("contact_position", &r.position).map_err(e)?;
         npz.finish().map_err(e)?;
         Ok(())
     })?;
@@ -70,9 +72,14 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
             "stable_dt": results.stable_dt,
             "steps": results.steps,
             "simulated_time": results.steps as f64 * results.dt,
-            "samples": results.recorder.len(),
+            "samples": results.steps / case.settings.output_every + 1,
         },
         "contacts": results.contacts,
+        "contact_geometry": case.model.contacts.iter().map(|c| json!({
+            "name": c.name,
+            "obstacle": c.obstacle.kind(),
+            "outline": c.obstacle.outline(),
+        })).collect::<Vec<_>>(),
         "energy_balance": results.energy,
         "solver": {
             "counters": s,
@@ -99,7 +106,10 @@ pub fn write_summary(dir: &Path, summary: &serde_json::Value) -> Result<PathBuf>
     Ok(path)
 }
 
-fn write_atomically(path: &Path, write: impl FnOnce(File) -> std::io::Result<()>) -> Result<()> {
+pub(crate) fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(File) -> std::io::Result<()>,
+) -> Result<()> {
     let tmp = path.with_extension("partial");
     let file = File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
     if let Err(e) = write(file) {

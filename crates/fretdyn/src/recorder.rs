@@ -1,4 +1,5 @@
-//! Output samples, preallocated for the whole run: writing a sample allocates nothing.
+//! Output samples, preallocated (for the whole run, or for a chunk that a streaming driver
+//! drains with [`Recorder::clear`]): writing a sample allocates nothing.
 
 use ndarray::{Array1, Array2, Array3};
 
@@ -21,6 +22,11 @@ pub struct Recorder {
     pub penetration: Array2<f64>,
     /// 0 open, 1 stick, 2 slip (N, c).
     pub status: Array2<i8>,
+    /// Position of the point relative to the obstacle (N, c, 2), m: for a hole, the offset
+    /// of the tube axis from the hole's centre in the hole's axes `(e1, e2)` — its orbit; for
+    /// a plane or bars, the distance from the plane (mid-plane) and the position along `t1`
+    /// ([`crate::obstacle::Obstacle::local`]).
+    pub position: Array3<f64>,
     len: usize,
 }
 
@@ -32,6 +38,7 @@ pub struct ContactSample {
     pub slip_velocity: [f64; 2],
     pub penetration: f64,
     pub status: i8,
+    pub position: [f64; 2],
 }
 
 impl Recorder {
@@ -46,6 +53,7 @@ impl Recorder {
             slip_velocity: Array3::zeros((samples, c, 2)),
             penetration: Array2::zeros((samples, c)),
             status: Array2::zeros((samples, c)),
+            position: Array3::zeros((samples, c, 2)),
             len: 0,
         }
     }
@@ -53,6 +61,21 @@ impl Recorder {
     /// Number of samples written.
     pub fn len(&self) -> usize {
         self.len
+    }
+
+    /// Room for this many samples.
+    pub fn capacity(&self) -> usize {
+        self.t.len()
+    }
+
+    /// True when no other sample fits.
+    pub fn is_full(&self) -> bool {
+        self.len >= self.t.len()
+    }
+
+    /// Forgets the samples written (after they were saved), keeping the room.
+    pub fn clear(&mut self) {
+        self.len = 0;
     }
 
     /// True when nothing was written.
@@ -90,6 +113,8 @@ impl Recorder {
         self.slip_velocity[[n, c, 1]] = s.slip_velocity[1];
         self.penetration[[n, c]] = s.penetration;
         self.status[[n, c]] = s.status;
+        self.position[[n, c, 0]] = s.position[0];
+        self.position[[n, c, 1]] = s.position[1];
     }
 
     /// Drops the unwritten tail (after an early stop), keeping the samples written.
@@ -109,5 +134,6 @@ impl Recorder {
             .to_owned();
         self.penetration = self.penetration.slice(ndarray::s![..n, ..]).to_owned();
         self.status = self.status.slice(ndarray::s![..n, ..]).to_owned();
+        self.position = self.position.slice(ndarray::s![..n, .., ..]).to_owned();
     }
 }

@@ -7,7 +7,7 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use nalgebra::{Vector2, Vector3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::central_difference::CentralDifference;
 use crate::delassus::{Slot, TangentialProblem};
@@ -18,7 +18,10 @@ use crate::model::Model;
 use crate::obstacle::ContactFrame;
 use crate::recorder::{ContactSample, Recorder};
 use crate::stability::stable_time_step;
-use crate::statistics::{ContactAccumulator, ContactStatistics, EnergyBalance};
+use crate::statistics::{
+    BlockStatistics, ContactStatistics, ContactStatisticsState, EnergyBalance, EnergyRaw, Impact,
+    StatisticsSettings, StepValues,
+};
 use crate::tangential::active_set::{ActiveSet, History};
 use crate::tangential::penalty::PenaltyContact;
 use crate::tangential::{SolverStatistics, StickVelocity, TangentialMethod, gauss_seidel};
@@ -36,6 +39,8 @@ pub struct RunSettings {
     pub stick_velocity: StickVelocity,
     /// Keep every `output_every`-th step in the recorded time histories (statistics use all).
     pub output_every: u64,
+    /// Window, blocks and impact definition of the statistics.
+    pub statistics: StatisticsSettings,
 }
 
 impl RunSettings {
@@ -53,6 +58,7 @@ impl RunSettings {
                 "must be at least 1 (1 keeps every step)",
             ));
         }
+        self.statistics.validate("statistics")?;
         match &self.method {
             TangentialMethod::Penalty(p) => {
                 if !(p.stiffness.is_finite() && p.stiffness > 0.0) {
@@ -137,6 +143,8 @@ pub enum Termination {
     },
     /// The observer asked to stop.
     Stopped { step: u64 },
+    /// Still running (statistics of a checkpoint).
+    InProgress { step: u64 },
 }
 
 /// Everything a run produces.
@@ -144,8 +152,13 @@ pub enum Termination {
 pub struct RunResults {
     /// Output time histories.
     pub recorder: Recorder,
-    /// Per-contact statistics over every step done.
+    /// Per-contact statistics over every step of the window (THEORY §5).
     pub contacts: Vec<ContactStatistics>,
+    /// Finished impacts of the window, in the order they ended (not drained by a streaming
+    /// driver).
+    pub impacts: Vec<Impact>,
+    /// Per-block statistics, block by block, contact by contact (when blocks are set).
+    pub blocks: Vec<BlockStatistics>,
     /// Tangential solver counters.
     pub solver: SolverStatistics,
     /// Energy balance.
@@ -188,48 +201,84 @@ pub fn run(
     settings: &RunSettings,
     mut observer: impl FnMut(Progress) -> ControlFlow<()>,
 ) -> Result<RunResults> {
-    model.validate()?;
-    settings.validate()?;
-    let stable_dt = stable_time_step(model, &settings.method);
-    if settings.dt >= stable_dt {
-        return Err(Error::UnstableTimeStep {
-            dt: settings.dt,
-            limit: stable_dt,
-            suggest: round_down(0.9 * stable_dt),
-        });
-    }
-    let mut sim = Simulation::new(model, settings, stable_dt);
     let start = Instant::now();
-    sim.start();
+    let mut sim = Simulation::new(model, settings)?;
     let total = settings.steps;
     let mut termination = Termination::Completed;
-    for n in 0..total {
-        if let Err(contact) = sim.step() {
-            termination = Termination::Diverged {
-                step: n + 1,
-                time: (n + 1) as f64 * settings.dt,
-                contact: contact.map(|c| model.contacts[c].name.clone()),
-            };
+    while sim.steps_done() < total {
+        if let Err(d) = sim.step() {
+            termination = d.into_termination(model);
             break;
         }
-        if (n + 1) % 1024 == 0
-            && n + 1 < total
-            && observer(Progress { step: n + 1, total }).is_break()
-        {
-            termination = Termination::Stopped { step: n + 1 };
+        let n = sim.steps_done();
+        if n % 1024 == 0 && n < total && observer(Progress { step: n, total }).is_break() {
+            termination = Termination::Stopped { step: n };
             break;
         }
     }
     let wall_time = start.elapsed().as_secs_f64();
     let _ = observer(Progress {
-        step: sim.step,
+        step: sim.steps_done(),
         total,
     });
-    Ok(sim.finish(wall_time, stable_dt, termination))
+    Ok(sim.finish(wall_time, termination))
+}
+
+/// A step whose state became non-finite.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Divergence {
+    /// The step, counted from 1.
+    pub step: u64,
+    /// Its end time, s.
+    pub time: f64,
+    /// The contact whose force was non-finite first, if any.
+    pub contact: Option<usize>,
+}
+
+impl Divergence {
+    /// The [`Termination`] it causes.
+    pub fn into_termination(self, model: &Model) -> Termination {
+        Termination::Diverged {
+            step: self.step,
+            time: self.time,
+            contact: self.contact.map(|c| model.contacts[c].name.clone()),
+        }
+    }
+}
+
+/// Everything that the steps after step `step` depend on: a run restored from it continues
+/// bit for bit as the run it was taken from ([`Simulation::snapshot`],
+/// [`Simulation::resume`]). The loads are pure functions of time and need nothing here.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Snapshot {
+    /// Steps done.
+    pub step: u64,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+    contacts: Vec<ContactState>,
+    penalty: Vec<PenaltyContact>,
+    history: Vec<History>,
+    previous_lambda: Vec<Vector2<f64>>,
+    statistics: ContactStatisticsState,
+    solver: SolverStatistics,
+    energy: EnergyRaw,
+}
+
+impl Snapshot {
+    /// Binary encoding (bincode: exact for every `f64`).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        bincode::serialize(self).expect("a snapshot always serializes")
+    }
+
+    /// Decodes [`Self::to_bytes`]; `None` when the bytes are not a snapshot.
+    pub fn from_bytes(bytes: &[u8]) -> Option<Self> {
+        bincode::deserialize(bytes).ok()
+    }
 }
 
 /// Per-contact state within a step.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 struct ContactState {
     frame: ContactFrame,
     /// Physical position of the point.
@@ -297,7 +346,10 @@ enum LagrangeSolver {
     ActiveSet(Box<ActiveSet>),
 }
 
-struct Simulation<'m> {
+/// A run in progress: create it with [`Simulation::new`] (or [`Simulation::resume`]), advance
+/// it with [`Simulation::step`], drain its [`Recorder`] and finished impacts as it goes, end
+/// it with [`Simulation::finish`]. [`run`] does all of it for a run held in memory.
+pub struct Simulation<'m> {
     model: &'m Model,
     settings: &'m RunSettings,
     cd: CentralDifference,
@@ -308,17 +360,197 @@ struct Simulation<'m> {
     surface_rows: Vec<f64>,
     /// Modal loads `Φ_lᵀ F_l`, one row of p per load.
     load_rows: Vec<f64>,
+    /// Signal generators of the turbulent loads, one per load.
+    turbulence: Vec<crate::turbulence::RandomChannels>,
+    /// Work space: the turbulence signals at the current time.
+    signals: Vec<f64>,
     external: Vec<f64>,
     force: Vec<f64>,
-    accumulators: Vec<ContactAccumulator>,
+    names: Vec<String>,
+    statistics: ContactStatisticsState,
     solver_stats: SolverStatistics,
+    stable_dt: f64,
     energy: EnergyBalance,
     recorder: Recorder,
     step: u64,
 }
 
 impl<'m> Simulation<'m> {
-    fn new(model: &'m Model, settings: &'m RunSettings, _stable_dt: f64) -> Self {
+    /// Checks the model and the settings (Δt against the stability limit), allocates
+    /// everything the steps need, with room for every output sample of the run, and computes
+    /// the state at t = 0 (the first sample).
+    pub fn new(model: &'m Model, settings: &'m RunSettings) -> Result<Self> {
+        let samples = (settings.steps / settings.output_every + 1) as usize;
+        Self::with_recorder(model, settings, samples)
+    }
+
+    /// As [`Self::new`], with room for `samples` output samples only: the caller drains the
+    /// recorder ([`Recorder::clear`]) before it is full, so that memory does not grow with the
+    /// length of the run.
+    pub fn with_recorder(
+        model: &'m Model,
+        settings: &'m RunSettings,
+        samples: usize,
+    ) -> Result<Self> {
+        let stable_dt = Self::check(model, settings)?;
+        let mut sim = Self::allocate(model, settings, stable_dt, samples.max(1))?;
+        sim.start();
+        Ok(sim)
+    }
+
+    /// Continues a run from a [`Snapshot`] taken by [`Self::snapshot`] on the same model and
+    /// settings; the recorder (room for `samples`) starts empty, at the step after it.
+    pub fn resume(
+        model: &'m Model,
+        settings: &'m RunSettings,
+        snapshot: Snapshot,
+        samples: usize,
+    ) -> Result<Self> {
+        let stable_dt = Self::check(model, settings)?;
+        let mut sim = Self::allocate(model, settings, stable_dt, samples.max(1))?;
+        let p = model.basis.modes();
+        let nc = model.contacts.len();
+        let mismatch = |what: &str| {
+            Error::invalid(
+                "checkpoint",
+                format!(
+                    "its {what} does not match the case: was the case file changed since the run started?"
+                ),
+            )
+        };
+        if snapshot.q.len() != p || snapshot.qd.len() != p || snapshot.qdd.len() != p {
+            return Err(mismatch("number of modes"));
+        }
+        if snapshot.contacts.len() != nc
+            || snapshot.history.len() != nc
+            || snapshot.previous_lambda.len() != nc
+            || !snapshot.statistics.has_contacts(nc)
+        {
+            return Err(mismatch("number of contacts"));
+        }
+        sim.step = snapshot.step;
+        sim.cd.q.copy_from_slice(&snapshot.q);
+        sim.cd.qd.copy_from_slice(&snapshot.qd);
+        sim.cd.qdd.copy_from_slice(&snapshot.qdd);
+        sim.contacts = snapshot.contacts;
+        match &mut sim.tangential {
+            Tangential::Penalty { contacts, .. } => {
+                if snapshot.penalty.len() != nc {
+                    return Err(mismatch("tangential method"));
+                }
+                *contacts = snapshot.penalty;
+            }
+            Tangential::Lagrange {
+                history,
+                previous_lambda,
+                ..
+            } => {
+                if !snapshot.penalty.is_empty() {
+                    return Err(mismatch("tangential method"));
+                }
+                *history = snapshot.history;
+                *previous_lambda = snapshot.previous_lambda;
+            }
+        }
+        sim.statistics = snapshot.statistics;
+        sim.solver_stats = snapshot.solver;
+        sim.energy = EnergyBalance::from_raw(&snapshot.energy);
+        Ok(sim)
+    }
+
+    /// The state after the steps done, for [`Self::resume`].
+    pub fn snapshot(&self) -> Snapshot {
+        let nc = self.contacts.len();
+        let (penalty, history, previous_lambda) = match &self.tangential {
+            Tangential::Penalty { contacts, .. } => (
+                contacts.clone(),
+                vec![History::default(); nc],
+                vec![Vector2::zeros(); nc],
+            ),
+            Tangential::Lagrange {
+                history,
+                previous_lambda,
+                ..
+            } => (Vec::new(), history.clone(), previous_lambda.clone()),
+        };
+        Snapshot {
+            step: self.step,
+            q: self.cd.q.clone(),
+            qd: self.cd.qd.clone(),
+            qdd: self.cd.qdd.clone(),
+            contacts: self.contacts.clone(),
+            penalty,
+            history,
+            previous_lambda,
+            statistics: self.statistics.clone(),
+            solver: self.solver_stats.clone(),
+            energy: self.energy.raw(),
+        }
+    }
+
+    /// Steps done.
+    pub fn steps_done(&self) -> u64 {
+        self.step
+    }
+
+    /// Time reached, s.
+    pub fn time(&self) -> f64 {
+        self.step as f64 * self.settings.dt
+    }
+
+    /// Stability limit of the time step, s.
+    pub fn stable_dt(&self) -> f64 {
+        self.stable_dt
+    }
+
+    /// The output samples not yet drained.
+    pub fn recorder(&self) -> &Recorder {
+        &self.recorder
+    }
+
+    /// The output samples, to drain ([`Recorder::clear`]).
+    pub fn recorder_mut(&mut self) -> &mut Recorder {
+        &mut self.recorder
+    }
+
+    /// Statistics in progress, whose finished impacts and blocks may be drained.
+    pub fn statistics_mut(&mut self) -> &mut ContactStatisticsState {
+        &mut self.statistics
+    }
+
+    /// Solver counters so far.
+    pub fn solver_statistics(&self) -> &SolverStatistics {
+        &self.solver_stats
+    }
+
+    /// Energy balance so far.
+    pub fn energy(&self) -> &EnergyBalance {
+        &self.energy
+    }
+
+    /// Checks the model and the settings, Δt against the stability limit; returns that
+    /// limit. [`Self::new`] does it; a front end calls it to refuse bad input before it
+    /// creates any output.
+    pub fn check(model: &Model, settings: &RunSettings) -> Result<f64> {
+        model.validate()?;
+        settings.validate()?;
+        let stable_dt = stable_time_step(model, &settings.method);
+        if settings.dt >= stable_dt {
+            return Err(Error::UnstableTimeStep {
+                dt: settings.dt,
+                limit: stable_dt,
+                suggest: round_down(0.9 * stable_dt),
+            });
+        }
+        Ok(stable_dt)
+    }
+
+    fn allocate(
+        model: &'m Model,
+        settings: &'m RunSettings,
+        stable_dt: f64,
+        samples: usize,
+    ) -> Result<Self> {
         let p = model.basis.modes();
         let nc = model.contacts.len();
         let mut cd = CentralDifference::new(model, settings.dt);
@@ -332,9 +564,32 @@ impl<'m> Simulation<'m> {
                 &mut load_rows[l * p..(l + 1) * p],
             );
         }
+        for load in &model.modal_loads {
+            load_rows.extend_from_slice(&load.row);
+        }
         if let Some(base) = &model.base_acceleration {
             load_rows.extend(base.modal_row(&model.basis.participation));
         }
+        let turbulence = model
+            .turbulence
+            .iter()
+            .enumerate()
+            .map(|(k, l)| {
+                crate::turbulence::RandomChannels::new(
+                    &l.spectrum,
+                    l.channels(p),
+                    l.seed,
+                    l.f_max,
+                    &format!("turbulence[{k}]"),
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let channels = model
+            .turbulence
+            .iter()
+            .map(|l| l.channels(p))
+            .max()
+            .unwrap_or(0);
         let tangential = match settings.method {
             TangentialMethod::Penalty(s) => Tangential::Penalty {
                 settings: s,
@@ -350,7 +605,6 @@ impl<'m> Simulation<'m> {
                 LagrangeSolver::ActiveSet(Box::new(ActiveSet::new(s, nc))),
             ),
         };
-        let samples = (settings.steps / settings.output_every + 1) as usize;
         let blank = ContactState {
             frame: ContactFrame {
                 penetration: 0.0,
@@ -366,7 +620,7 @@ impl<'m> Simulation<'m> {
             closed: false,
             slide: Slide::Stick,
         };
-        Self {
+        Ok(Self {
             model,
             settings,
             cd,
@@ -374,14 +628,18 @@ impl<'m> Simulation<'m> {
             tangential,
             surface_rows: vec![0.0; 3 * p * nc],
             load_rows,
+            turbulence,
+            signals: vec![0.0; channels],
             external: vec![0.0; p],
             force: vec![0.0; p],
-            accumulators: vec![ContactAccumulator::default(); nc],
+            names: model.contacts.iter().map(|c| c.name.clone()).collect(),
+            statistics: ContactStatisticsState::new(nc, &settings.statistics),
             solver_stats: SolverStatistics::default(),
+            stable_dt,
             energy: EnergyBalance::default(),
             recorder: Recorder::new(samples, p, nc),
             step: 0,
-        }
+        })
     }
 
     /// t = 0: contacts at the initial state, initial acceleration, first sample.
@@ -402,13 +660,32 @@ impl<'m> Simulation<'m> {
         }
         let (e, powers) = self.energy_and_powers();
         self.energy = EnergyBalance::start(e, powers);
+        self.statistics.start(
+            self.contacts
+                .iter()
+                .map(|c| (c.frame.penetration, c.closed)),
+        );
         self.full_step_velocities(true);
         self.sample();
     }
 
-    /// One step n → n+1. `Err(Some(c))`: contact `c` produced a non-finite force;
-    /// `Err(None)`: the modal state became non-finite.
-    fn step(&mut self) -> std::result::Result<(), Option<usize>> {
+    /// One step n → n+1: the state, the statistics and, every `output_every` steps, an
+    /// output sample. A non-finite contact force or modal state stops with a [`Divergence`]
+    /// (the statistics then cover the steps before it).
+    pub fn step(&mut self) -> std::result::Result<(), Divergence> {
+        match self.try_step()? {
+            Some(k) => Err(Divergence {
+                step: self.step + 1,
+                time: (self.step + 1) as f64 * self.settings.dt,
+                contact: Some(k),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// The step; `Ok(Some(c))` when contact `c`'s force is non-finite, `Err` for a
+    /// non-finite modal state.
+    fn try_step(&mut self) -> std::result::Result<Option<usize>, Divergence> {
         self.step += 1;
         let t = self.step as f64 * self.settings.dt;
         self.cd.predict();
@@ -421,43 +698,65 @@ impl<'m> Simulation<'m> {
         self.full_step_velocities(false);
 
         let dt = self.settings.dt;
-        for (k, c) in self.contacts.iter().enumerate() {
-            if !(c.normal_force.is_finite() && c.tangential_force.iter().all(|v| v.is_finite())) {
-                return Err(Some(k));
-            }
-            let power = if c.closed {
-                c.tangential_force.dot(&c.tangential_velocity()).abs()
-            } else {
-                0.0
-            };
-            self.accumulators[k].add(
-                c.closed,
-                c.slide == Slide::Stick,
-                c.normal_force,
-                c.tangential_force.norm(),
-                power,
-                c.frame.penetration,
-                dt,
-            );
+        if let Some(k) = self.contacts.iter().position(|c| {
+            !(c.normal_force.is_finite() && c.tangential_force.iter().all(|v| v.is_finite()))
+        }) {
+            self.step -= 1;
+            return Ok(Some(k));
         }
         let (e, powers) = self.energy_and_powers();
         if !e.is_finite() {
-            return Err(None);
+            self.step -= 1;
+            return Err(Divergence {
+                step: self.step + 1,
+                time: (self.step + 1) as f64 * dt,
+                contact: None,
+            });
         }
         self.energy.step(e, powers, dt);
+        let model = self.model;
+        let values = self.contacts.iter().zip(&model.contacts).map(|(s, c)| {
+            let local = c.local(&s.x, t);
+            let (radial, angle) = if c.obstacle.is_hole() {
+                (local.norm(), local.y.atan2(local.x))
+            } else {
+                (local.x, 0.0)
+            };
+            let (slip_speed, friction_power) = if s.closed {
+                let vt = s.tangential_velocity();
+                (vt.norm(), s.tangential_force.dot(&vt).abs())
+            } else {
+                (0.0, 0.0)
+            };
+            StepValues {
+                t,
+                closed: s.closed,
+                stick: s.slide == Slide::Stick,
+                normal: s.normal_force,
+                tangential: s.tangential_force.norm(),
+                slip_speed,
+                friction_power,
+                penetration: s.frame.penetration,
+                radial,
+                angle,
+            }
+        });
+        self.statistics
+            .step(&self.settings.statistics, &self.names, t, dt, values);
         if self.step % self.settings.output_every == 0 {
             self.full_step_velocities(true);
             self.sample();
         }
-        Ok(())
+        Ok(None)
     }
 
     fn external_force(&mut self, t: f64) {
         let p = self.external.len();
         self.external.iter_mut().for_each(|f| *f = 0.0);
         let histories = self.model.loads.iter().map(|l| &l.history);
+        let modal = self.model.modal_loads.iter().map(|l| &l.history);
         let base = self.model.base_acceleration.iter().map(|b| &b.history);
-        for (l, history) in histories.chain(base).enumerate() {
+        for (l, history) in histories.chain(modal).chain(base).enumerate() {
             let s = history.value(t);
             for (f, g) in self
                 .external
@@ -465,6 +764,16 @@ impl<'m> Simulation<'m> {
                 .zip(&self.load_rows[l * p..(l + 1) * p])
             {
                 *f += s * g;
+            }
+        }
+        for (load, generator) in self.model.turbulence.iter().zip(&mut self.turbulence) {
+            let r = generator.channels();
+            let xi = &mut self.signals[..r];
+            generator.values(t, xi);
+            for (j, x) in xi.iter().enumerate() {
+                for (f, g) in self.external.iter_mut().zip(&load.rows[j * p..(j + 1) * p]) {
+                    *f += x * g;
+                }
             }
         }
     }
@@ -715,8 +1024,9 @@ impl<'m> Simulation<'m> {
         if !self.recorder.push_state(t, &self.cd.q, &self.cd.qd) {
             return;
         }
-        for (k, s) in self.contacts.iter().enumerate() {
+        for (k, (s, c)) in self.contacts.iter().zip(&self.model.contacts).enumerate() {
             let vt = s.tangential_velocity();
+            let local = c.local(&s.x, t);
             self.recorder.contact(
                 k,
                 &ContactSample {
@@ -725,23 +1035,45 @@ impl<'m> Simulation<'m> {
                     slip_velocity: [vt.x, vt.y],
                     penetration: s.frame.penetration,
                     status: s.status_code(),
+                    position: [local.x, local.y],
                 },
             );
         }
     }
 
-    fn finish(mut self, wall_time: f64, stable_dt: f64, termination: Termination) -> RunResults {
+    /// The statistics so far, without ending the run (its recorder is empty).
+    pub fn partial_results(&self, wall_time: f64) -> RunResults {
+        let mut statistics = self.statistics.clone();
+        let contacts = statistics.finish(&self.settings.statistics, &self.names, self.settings.dt);
+        RunResults {
+            recorder: Recorder::new(0, self.cd.q.len(), self.contacts.len()),
+            contacts,
+            impacts: Vec::new(),
+            blocks: Vec::new(),
+            solver: self.solver_stats.clone(),
+            energy: self.energy.clone(),
+            steps: self.step,
+            dt: self.settings.dt,
+            stable_dt: self.stable_dt,
+            wall_time,
+            termination: Termination::InProgress { step: self.step },
+        }
+    }
+
+    /// Ends the run: window statistics, last partial block, the samples and impacts not
+    /// drained. `wall_time` is the caller's measure of the time spent stepping.
+    pub fn finish(mut self, wall_time: f64, termination: Termination) -> RunResults {
         self.recorder.truncate();
         let dt = self.settings.dt;
         let steps = self.step;
+        let stable_dt = self.stable_dt;
+        let contacts = self
+            .statistics
+            .finish(&self.settings.statistics, &self.names, dt);
         RunResults {
-            contacts: self
-                .model
-                .contacts
-                .iter()
-                .zip(&self.accumulators)
-                .map(|(c, a)| a.finish(&c.name, steps, dt))
-                .collect(),
+            contacts,
+            impacts: std::mem::take(&mut self.statistics.impacts),
+            blocks: std::mem::take(&mut self.statistics.blocks),
             recorder: self.recorder,
             solver: self.solver_stats,
             energy: self.energy,

@@ -146,6 +146,72 @@ impl TubeStructure {
     }
 }
 
+/// A node of a tube under a line load: its arc length, the length of tube it carries, and its
+/// translation rows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LineNode {
+    /// Arc length `s` along the tube from its first node, m.
+    pub s: f64,
+    /// Tributary length `w`, m: a uniform load `f` per unit length over the span gives the
+    /// nodal force `w f` (lumped, statically equivalent element by element).
+    pub weight: f64,
+    /// Translation rows (3 × p, row-major).
+    pub rows: Vec<f64>,
+}
+
+impl TubeStructure {
+    /// Length of the tube along its axis, m.
+    pub fn length(&self) -> f64 {
+        let n = &self.beam.mesh.nodes;
+        self.beam
+            .mesh
+            .elements
+            .iter()
+            .map(|[a, b]| (n[*b] - n[*a]).norm())
+            .sum()
+    }
+
+    /// The nodes carrying a line load on the arc-length span `[s0, s1]`: each element's
+    /// overlap with the span, of length `ℓ` and centroid `c`, is shared between its end nodes
+    /// `a`, `b` as `ℓ (s_b − c)/(s_b − s_a)` and `ℓ (c − s_a)/(s_b − s_a)` (same resultant
+    /// and same first moment as the uniform load). Nodes with no share are left out.
+    pub fn line_nodes(&self, basis: &TubeBasis, s0: f64, s1: f64) -> Vec<LineNode> {
+        let mesh = &self.beam.mesh;
+        let n = mesh.nodes.len();
+        // arc length of each node along the elements (numbered along the tube)
+        let mut s = vec![0.0; n];
+        let mut weight = vec![0.0; n];
+        let mut acc = 0.0;
+        for [a, b] in &mesh.elements {
+            let len = (mesh.nodes[*b] - mesh.nodes[*a]).norm();
+            s[*a] = acc;
+            acc += len;
+            s[*b] = acc;
+            let (lo, hi) = (s[*a].max(s0), s[*b].min(s1));
+            if hi > lo && len > 0.0 {
+                let (l, c) = (hi - lo, 0.5 * (lo + hi));
+                weight[*a] += l * (s[*b] - c) / len;
+                weight[*b] += l * (c - s[*a]) / len;
+            }
+        }
+        (0..n)
+            .filter(|&i| weight[i] > 0.0)
+            .map(|i| {
+                let pt = NamedPoint {
+                    name: String::new(),
+                    node: i,
+                    offset: Vector3::zeros(),
+                };
+                LineNode {
+                    s: s[i],
+                    weight: weight[i],
+                    rows: point_rows(&basis.assembled, &basis.modes.shapes, &pt),
+                }
+            })
+            .collect()
+    }
+}
+
 /// Rows (3 × p) of a named point from shapes (n × p) over the reduced DOFs:
 /// `u + θ × r` with `r` the point's offset; a restrained DOF contributes nothing.
 fn point_rows(assembled: &Assembled, shapes: &DMatrix<f64>, pt: &NamedPoint) -> Vec<f64> {

@@ -21,6 +21,7 @@ fn settings(method: TangentialMethod, dt: f64, steps: u64) -> RunSettings {
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1,
+        statistics: Default::default(),
     }
 }
 

@@ -782,6 +782,7 @@ fn time_step_above_the_stable_limit_is_refused_with_the_limit_in_the_message() {
         method: gs(),
         stick_velocity: Default::default(),
         output_every: 1,
+        statistics: Default::default(),
     };
     let err = simulate(&model, &settings).expect_err("Δt above the limit must be refused");
     let fretdyn::Error::UnstableTimeStep { dt, limit: l, .. } = &err else {
@@ -827,6 +828,7 @@ fn time_step_just_below_the_limit_is_stable() {
         method: gs(),
         stick_velocity: Default::default(),
         output_every: 1,
+        statistics: Default::default(),
     };
     let r = run(&model, &settings, |_| ControlFlow::Continue(())).unwrap();
     assert_eq!(r.termination, Termination::Completed);

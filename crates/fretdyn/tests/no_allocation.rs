@@ -1,5 +1,5 @@
-//! The time-step loop allocates nothing: a run of 10× more steps makes exactly as many heap
-//! allocations (all of them in the set-up and in the results), counted by a global allocator
+//! The time-step loop allocates nothing, random turbulence included: a run of 10× more steps
+//! makes exactly as many heap allocations (all of them in the set-up and in the results), counted by a global allocator
 //! on the test's own thread only (the test harness allocates on its main thread meanwhile).
 
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -44,9 +44,32 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-fn allocations_of_run(method: TangentialMethod, steps: u64) -> (usize, u64) {
+fn allocations_of_run(method: TangentialMethod, steps: u64, turbulence: bool) -> (usize, u64) {
     let mut case = rattling_tube(10, 4, method, steps);
     case.settings.output_every = 100;
+    if turbulence {
+        // 3 random channels on the modes, sampled at 80 kHz: 20 000 steps cross several
+        // blocks of the generator
+        let p = case.model.basis.modes();
+        case.model.turbulence.push(fretdyn::load::TurbulentLoad {
+            spectrum: fretdyn::turbulence::Spectrum::Table {
+                frequency_hz: vec![5e3, 1e4],
+                psd: vec![1.0, 1.0],
+            },
+            rows: (0..3 * p).map(|i| 0.1 * ((i % 7) as f64 - 3.0)).collect(),
+            seed: 1,
+            f_max: 1e4,
+        });
+        let load = &case.model.turbulence[0];
+        let g = fretdyn::turbulence::RandomChannels::new(&load.spectrum, 3, 1, load.f_max, "t")
+            .unwrap();
+        let samples = 20_000.0 * case.settings.dt * g.sample_rate();
+        assert!(
+            samples > 2.0 * g.block_length() as f64,
+            "{samples} samples, blocks of {}",
+            g.block_length()
+        );
+    }
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     let r = simulate(&case.model, &case.settings).expect("valid case");
     (
@@ -66,19 +89,21 @@ fn the_step_loop_does_not_allocate() {
         TangentialMethod::ActiveSet(ActiveSetSettings::default()),
         TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
     ] {
-        let (short, _) = allocations_of_run(method, 2_000);
-        let (long, contact_steps) = allocations_of_run(method, 20_000);
-        assert!(
-            method.is_lagrange() == (contact_steps > 1000),
-            "{}: the run must exercise the contact solver ({contact_steps} steps)",
-            method.name()
-        );
-        assert!(short > 0, "the counter sees the set-up's allocations");
-        assert_eq!(
-            short,
-            long,
-            "{}: {short} allocations for 2 000 steps, {long} for 20 000",
-            method.name()
-        );
+        for turbulence in [false, true] {
+            let (short, _) = allocations_of_run(method, 2_000, turbulence);
+            let (long, contact_steps) = allocations_of_run(method, 20_000, turbulence);
+            assert!(
+                method.is_lagrange() == (contact_steps > 1000),
+                "{}: the run must exercise the contact solver ({contact_steps} steps)",
+                method.name()
+            );
+            assert!(short > 0, "the counter sees the set-up's allocations");
+            assert_eq!(
+                short,
+                long,
+                "{} (turbulence {turbulence}): {short} allocations for 2 000 steps, {long} for 20 000",
+                method.name()
+            );
+        }
     }
 }

@@ -96,6 +96,7 @@ fn run(model: &Model, case: &Case, method: TangentialMethod) -> RunResults {
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1,
+        statistics: Default::default(),
         ..case.settings.clone()
     };
     simulate(model, &settings).expect("valid run")
@@ -155,7 +156,7 @@ fn compare_all_modes(text: &str, methods: &[TangentialMethod]) {
     let mut physical = physical;
     physical.contacts = case.model.contacts.clone();
     physical.loads = case.model.loads.clone();
-    physical.base_acceleration = case.model.base_acceleration;
+    physical.base_acceleration = case.model.base_acceleration.clone();
     for &method in methods {
         let a = run(&physical, &case, method);
         let b = run(&case.model, &case, method);

@@ -25,7 +25,7 @@ use crate::delassus::TangentialProblem;
 use crate::friction::{LocalSolve, Slide, local_solve};
 
 /// Memory of a contact between steps: its last status and slip direction.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct History {
     /// Whether the contact was closed at the previous step.
     pub closed: bool,

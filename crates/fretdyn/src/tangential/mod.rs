@@ -121,7 +121,7 @@ impl TangentialMethod {
 }
 
 /// Counters of the tangential solvers over a run; never hidden, always reported.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct SolverStatistics {
     /// Steps with at least one closed contact solved by a Lagrange method.
     pub lagrange_steps: u64,

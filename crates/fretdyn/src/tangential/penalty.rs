@@ -19,7 +19,7 @@ use super::PenaltySettings;
 use crate::friction::{Coulomb, Slide};
 
 /// State of one contact under the penalty law.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PenaltyContact {
     /// Whether the contact was closed at the previous step.
     pub closed: bool,

@@ -1,0 +1,346 @@
+//! The plots of a run folder, drawn from its files only (`results.npz` — or `series/` of a run
+//! not finished —, `summary.json`, `impacts.csv`), so that `fretdyn run` and
+//! `fretdyn plot DIR` draw the same pictures:
+//! - `contact_forces.png`: normal and tangential force magnitude against time, per contact;
+//! - `contact_displacement.png`: the point's displacement at each contact against time (radial
+//!   offset from the hole's centre, or distance to the plane);
+//! - `orbits.png`: the orbit of the tube centre inside each hole, with the hole's outline;
+//! - `peak_forces.png`: histogram of the impacts' peak forces, per contact;
+//! - `wear.png`: wear work rate per contact (friction power and `R_N|v_T|` definitions).
+
+use std::path::{Path, PathBuf};
+
+use ndarray::{Array1, Array2, Array3, Ix1, Ix2, Ix3};
+use ndarray_npy::{NpzReader, ReadNpyExt};
+use serde_json::Value;
+
+use crate::Failure;
+use crate::plot::{Bar, Series, bar_panels, panels_plot, xy_panels};
+
+/// The time histories the plots need.
+struct Histories {
+    t: Array1<f64>,
+    normal: Array2<f64>,
+    tangential: Array3<f64>,
+    position: Array3<f64>,
+}
+
+fn read_histories(dir: &Path) -> Result<Histories, String> {
+    let npz = dir.join(fretdyn::stream::RESULTS_FILE);
+    if npz.exists() {
+        let file = std::fs::File::open(&npz).map_err(|e| format!("{}: {e}", npz.display()))?;
+        let mut z = NpzReader::new(file).map_err(|e| format!("{}: {e}", npz.display()))?;
+        let err = |k: &str, e: ndarray_npy::ReadNpzError| format!("{}: {k}: {e}", npz.display());
+        Ok(Histories {
+            t: z.by_name::<_, Ix1>("t.npy").map_err(|e| err("t", e))?,
+            normal: z
+                .by_name::<_, Ix2>("contact_normal_force.npy")
+                .map_err(|e| err("contact_normal_force", e))?,
+            tangential: z
+                .by_name::<_, Ix3>("contact_tangential_force.npy")
+                .map_err(|e| err("contact_tangential_force", e))?,
+            position: z
+                .by_name::<_, Ix3>("contact_position.npy")
+                .map_err(|e| err("contact_position", e))?,
+        })
+    } else {
+        // a run stopped before its end: the streamed series
+        let series = dir.join(fretdyn::stream::SERIES_DIR);
+        fn npy<A: ReadNpyExt>(dir: &Path, key: &str) -> Result<A, String> {
+            let p = dir.join(format!("{key}.npy"));
+            let f = std::fs::File::open(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+            A::read_npy(f).map_err(|e| format!("{}: {e}", p.display()))
+        }
+        Ok(Histories {
+            t: npy(&series, "t")?,
+            normal: npy(&series, "contact_normal_force")?,
+            tangential: npy(&series, "contact_tangential_force")?,
+            position: npy(&series, "contact_position")?,
+        })
+    }
+}
+
+/// Peak forces of the impacts, per contact index, from `impacts.csv`.
+fn read_peaks(dir: &Path, contacts: usize) -> Vec<Vec<f64>> {
+    let mut peaks = vec![Vec::new(); contacts];
+    if let Ok(text) = std::fs::read_to_string(dir.join(fretdyn::stream::IMPACTS_FILE)) {
+        for line in text.lines().skip(1) {
+            let cols: Vec<&str> = line.split(',').collect();
+            if let (Some(Ok(k)), Some(Ok(p))) = (
+                cols.first().map(|c| c.parse::<usize>()),
+                cols.get(6).map(|c| c.parse::<f64>()),
+            ) {
+                if k < contacts {
+                    peaks[k].push(p);
+                }
+            }
+        }
+    }
+    peaks
+}
+
+/// Draws every plot of the run in `dir`; returns the files written.
+pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
+    let summary_path = dir.join("summary.json");
+    let summary: Value = std::fs::read_to_string(&summary_path)
+        .map_err(|e| e.to_string())
+        .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+        .map_err(|e| {
+            Failure::input(format!(
+                "{}: {e} (is {} a folder written by fretdyn run?)",
+                summary_path.display(),
+                dir.display()
+            ))
+        })?;
+    let h = read_histories(dir).map_err(Failure::input)?;
+    let title = summary["title"].as_str().unwrap_or("fretdyn").to_string();
+    let stats = summary["contacts"].as_array().cloned().unwrap_or_default();
+    let geometry = summary["contact_geometry"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let names: Vec<String> = stats
+        .iter()
+        .map(|c| c["name"].as_str().unwrap_or("?").to_string())
+        .collect();
+    let nc = names.len().min(h.normal.ncols());
+    let mut written = Vec::new();
+    if nc == 0 {
+        return Ok(written);
+    }
+    let fail = Failure::failed;
+    let t = h.t.to_vec();
+
+    // time histories of the forces
+    let columns: Vec<(Vec<f64>, Vec<f64>)> = (0..nc)
+        .map(|k| {
+            let n = h.normal.column(k).to_vec();
+            let tg = (0..h.t.len())
+                .map(|i| h.tangential[[i, k, 0]].hypot(h.tangential[[i, k, 1]]))
+                .collect();
+            (n, tg)
+        })
+        .collect();
+    let panels: Vec<(String, Vec<Series>)> = (0..nc)
+        .map(|k| {
+            (
+                names[k].clone(),
+                vec![
+                    Series {
+                        label: "normal R_N".into(),
+                        x: &t,
+                        y: &columns[k].0,
+                    },
+                    Series {
+                        label: "tangential |R_T|".into(),
+                        x: &t,
+                        y: &columns[k].1,
+                    },
+                ],
+            )
+        })
+        .collect();
+    let path = dir.join("contact_forces.png");
+    panels_plot(
+        &path,
+        &format!("{title} — contact forces"),
+        "t (s)",
+        "force (N)",
+        &panels,
+    )
+    .map_err(fail)?;
+    written.push(path);
+
+    // displacement at the contacts
+    let is_hole = |k: usize| geometry.get(k).is_some_and(|g| !g["outline"].is_null());
+    let displacement: Vec<Vec<f64>> = (0..nc)
+        .map(|k| {
+            (0..h.t.len())
+                .map(|i| {
+                    let (x, y) = (h.position[[i, k, 0]], h.position[[i, k, 1]]);
+                    if is_hole(k) { x.hypot(y) } else { x }
+                })
+                .collect()
+        })
+        .collect();
+    let panels: Vec<(String, Vec<Series>)> = (0..nc)
+        .map(|k| {
+            let label = if is_hole(k) {
+                "radial offset from the hole's centre"
+            } else {
+                "distance from the plane"
+            };
+            (
+                names[k].clone(),
+                vec![Series {
+                    label: label.into(),
+                    x: &t,
+                    y: &displacement[k],
+                }],
+            )
+        })
+        .collect();
+    let path = dir.join("contact_displacement.png");
+    panels_plot(
+        &path,
+        &format!("{title} — displacement at the contacts"),
+        "t (s)",
+        "m",
+        &panels,
+    )
+    .map_err(fail)?;
+    written.push(path);
+
+    // orbits in the holes
+    let holes: Vec<usize> = (0..nc).filter(|&k| is_hole(k)).collect();
+    if !holes.is_empty() {
+        let orbits: Vec<(Vec<f64>, Vec<f64>)> = holes
+            .iter()
+            .map(|&k| {
+                let mm = |i: usize| -> Vec<f64> {
+                    h.position
+                        .slice(ndarray::s![.., k, i])
+                        .iter()
+                        .map(|v| 1e3 * v)
+                        .collect()
+                };
+                (mm(0), mm(1))
+            })
+            .collect();
+        let outlines: Vec<(Vec<f64>, Vec<f64>)> = holes
+            .iter()
+            .map(|&k| {
+                let pts = geometry[k]["outline"]
+                    .as_array()
+                    .cloned()
+                    .unwrap_or_default();
+                let coord = |i: usize| -> Vec<f64> {
+                    pts.iter()
+                        .map(|p| 1e3 * p[i].as_f64().unwrap_or(0.0))
+                        .collect()
+                };
+                (coord(0), coord(1))
+            })
+            .collect();
+        let panels: Vec<(String, Vec<Series>)> = holes
+            .iter()
+            .enumerate()
+            .map(|(j, &k)| {
+                (
+                    names[k].clone(),
+                    vec![
+                        Series {
+                            label: "tube centre".into(),
+                            x: &orbits[j].0,
+                            y: &orbits[j].1,
+                        },
+                        Series {
+                            label: "hole (clearance)".into(),
+                            x: &outlines[j].0,
+                            y: &outlines[j].1,
+                        },
+                    ],
+                )
+            })
+            .collect();
+        let path = dir.join("orbits.png");
+        xy_panels(
+            &path,
+            &format!("{title} — orbit of the tube centre in the holes"),
+            "e1 (mm)",
+            "e2 (mm)",
+            &panels,
+        )
+        .map_err(fail)?;
+        written.push(path);
+    }
+
+    // histograms of the peak forces, 5 bins per decade
+    let peaks = read_peaks(dir, nc);
+    if peaks.iter().any(|p| !p.is_empty()) {
+        let panels: Vec<(String, Vec<Bar>)> = (0..nc)
+            .filter(|&k| !peaks[k].is_empty())
+            .map(|k| {
+                (
+                    format!("{} ({} impacts)", names[k], peaks[k].len()),
+                    histogram(&peaks[k], 5),
+                )
+            })
+            .collect();
+        let path = dir.join("peak_forces.png");
+        bar_panels(
+            &path,
+            &format!("{title} — peak force of the impacts"),
+            "impacts",
+            &panels,
+        )
+        .map_err(fail)?;
+        written.push(path);
+    }
+
+    // wear work rate per contact
+    let rate = |k: usize, key: &str| stats[k][key].as_f64().unwrap_or(0.0);
+    let panels = vec![
+        (
+            "friction power (1/T)∫|R_T·v_T| dt (W)".to_string(),
+            (0..nc)
+                .map(|k| Bar {
+                    label: names[k].clone(),
+                    value: rate(k, "wear_work_rate"),
+                })
+                .collect(),
+        ),
+        (
+            "normal-force definition (1/T)∫R_N|v_T| dt (W)".to_string(),
+            (0..nc)
+                .map(|k| Bar {
+                    label: names[k].clone(),
+                    value: rate(k, "normal_wear_work_rate"),
+                })
+                .collect(),
+        ),
+    ];
+    let path = dir.join("wear.png");
+    bar_panels(
+        &path,
+        &format!("{title} — wear work rate per contact"),
+        "W",
+        &panels,
+    )
+    .map_err(fail)?;
+    written.push(path);
+    Ok(written)
+}
+
+/// Logarithmic histogram, `per_decade` bins per decade, labelled by their lower edge.
+fn histogram(values: &[f64], per_decade: usize) -> Vec<Bar> {
+    let logs: Vec<f64> = values
+        .iter()
+        .filter(|v| **v > 0.0 && v.is_finite())
+        .map(|v| v.log10() * per_decade as f64)
+        .collect();
+    if logs.is_empty() {
+        return Vec::new();
+    }
+    let lo = logs.iter().copied().fold(f64::INFINITY, f64::min).floor() as i64;
+    let hi = logs
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max)
+        .floor() as i64;
+    let mut counts = vec![0usize; (hi - lo + 1) as usize];
+    for l in &logs {
+        counts[(l.floor() as i64 - lo) as usize] += 1;
+    }
+    counts
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| Bar {
+            label: format!(
+                "{:.3e} N",
+                10f64.powf((lo + i as i64) as f64 / per_decade as f64)
+            ),
+            value: c as f64,
+        })
+        .collect()
+}

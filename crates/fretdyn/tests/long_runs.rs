@@ -1,0 +1,218 @@
+//! Long runs: a streamed run gives the same results as a run held in memory; a run stopped
+//! (or killed after its checkpoint) and resumed gives, bit for bit, the results of an
+//! uninterrupted run.
+
+use std::ops::ControlFlow;
+use std::path::Path;
+
+use fretdyn::case::Case;
+use fretdyn::simulation::{Progress, RunResults, Termination, simulate};
+use fretdyn::statistics::StatisticsSettings;
+use fretdyn::stream::{self, ProgressOnly, StreamObserver, StreamSettings};
+use ndarray::{ArrayD, IxDyn};
+use ndarray_npy::NpzReader;
+
+const KEYS: [&str; 8] = [
+    "t",
+    "q",
+    "qdot",
+    "contact_normal_force",
+    "contact_tangential_force",
+    "contact_slip_velocity",
+    "contact_penetration",
+    "contact_position",
+];
+
+/// The multi-span tube, shortened, with blocks and a rest duration so that every output
+/// file has content.
+fn tube_case(steps: u64) -> Case {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/tube_multispan.toml");
+    let mut case = Case::from_file(&path).unwrap();
+    case.settings.steps = steps;
+    case.settings.output_every = 10;
+    case.settings.statistics = StatisticsSettings {
+        t_start: 0.01,
+        block: Some(0.02),
+        rest_duration: 2e-4,
+        ..Default::default()
+    };
+    case
+}
+
+fn read(dir: &Path) -> (Vec<ArrayD<f64>>, ArrayD<i8>) {
+    let mut npz = NpzReader::new(std::fs::File::open(dir.join("results.npz")).unwrap()).unwrap();
+    let f = KEYS
+        .iter()
+        .map(|k| {
+            npz.by_name::<ndarray::OwnedRepr<f64>, IxDyn>(&format!("{k}.npy"))
+                .unwrap()
+        })
+        .collect();
+    let status = npz
+        .by_name::<ndarray::OwnedRepr<i8>, IxDyn>("contact_status.npy")
+        .unwrap();
+    (f, status)
+}
+
+fn text(dir: &Path, name: &str) -> String {
+    std::fs::read_to_string(dir.join(name)).unwrap()
+}
+
+fn same_statistics(a: &RunResults, b: &RunResults) {
+    assert_eq!(a.contacts, b.contacts);
+    assert_eq!(a.solver, b.solver);
+    assert_eq!(a.energy, b.energy);
+    assert_eq!(a.steps, b.steps);
+}
+
+fn stream_settings(checkpoint_every_steps: Option<u64>) -> StreamSettings {
+    StreamSettings {
+        chunk_samples: 300,
+        checkpoint_every_steps,
+        checkpoint_every_seconds: None,
+    }
+}
+
+/// Stops the run at a given step, like Ctrl-C.
+struct StopAt(u64);
+
+impl StreamObserver for StopAt {
+    fn progress(&mut self, p: Progress) -> ControlFlow<()> {
+        if p.step >= self.0 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+/// Dies (panics, unwinding through the writers) at a given step, after a checkpoint: the
+/// files then hold more than the checkpoint saw, as after a `kill`.
+struct DieAt(u64);
+
+impl StreamObserver for DieAt {
+    fn progress(&mut self, p: Progress) -> ControlFlow<()> {
+        assert!(p.step < self.0, "killed");
+        ControlFlow::Continue(())
+    }
+}
+
+#[test]
+fn streamed_run_equals_the_run_in_memory_and_resumes_bit_for_bit() {
+    let steps = 10_000;
+    let case = tube_case(steps);
+    let tmp = tempdir();
+    let full = tmp.join("full");
+    let r_full = stream::run(
+        &case.model,
+        &case.settings,
+        &full,
+        &stream_settings(Some(3072)),
+        7,
+        &mut ProgressOnly(|_| ControlFlow::Continue(())),
+    )
+    .unwrap();
+    assert_eq!(r_full.termination, Termination::Completed);
+    assert!(!full.join("series").exists(), "series/ removed once packed");
+
+    // the same run in memory
+    let mem = simulate(&case.model, &case.settings).unwrap();
+    same_statistics(&mem, &r_full);
+    let (series, status) = read(&full);
+    let r = &mem.recorder;
+    let mem_series = [
+        r.t.clone().into_dyn(),
+        r.q.clone().into_dyn(),
+        r.qdot.clone().into_dyn(),
+        r.normal_force.clone().into_dyn(),
+        r.tangential_force.clone().into_dyn(),
+        r.slip_velocity.clone().into_dyn(),
+        r.penetration.clone().into_dyn(),
+        r.position.clone().into_dyn(),
+    ];
+    for ((k, a), b) in KEYS.iter().zip(&series).zip(&mem_series) {
+        assert_eq!(a, b, "{k}");
+    }
+    assert_eq!(status, r.status.clone().into_dyn());
+    assert_eq!(series[0].len(), (steps / 10 + 1) as usize);
+    // impacts and blocks: the same as in memory, in the same order
+    let impacts = text(&full, "impacts.csv");
+    assert_eq!(impacts.lines().count(), mem.impacts.len() + 1);
+    assert!(
+        mem.impacts.len() > 5,
+        "the case has impacts: {}",
+        mem.impacts.len()
+    );
+    for (line, i) in impacts.lines().skip(1).zip(&mem.impacts) {
+        let start: f64 = line.split(',').nth(2).unwrap().parse().unwrap();
+        assert_eq!(start, i.start);
+    }
+    let blocks = text(&full, "blocks.csv");
+    assert_eq!(blocks.lines().count(), mem.blocks.len() + 1);
+    assert_eq!(mem.blocks.len(), 5 * case.model.contacts.len());
+
+    // stopped at half time, then resumed
+    let stopped = tmp.join("stopped");
+    let r = stream::run(
+        &case.model,
+        &case.settings,
+        &stopped,
+        &stream_settings(None),
+        7,
+        &mut StopAt(5120),
+    )
+    .unwrap();
+    assert_eq!(r.termination, Termination::Stopped { step: 5120 });
+    // what was written is readable: results.npz up to the stop
+    let (partial, _) = read(&stopped);
+    assert_eq!(partial[0].len(), 5120 / 10 + 1);
+    let r = resume(&case, &stopped, 7).unwrap();
+    same_statistics(&r_full, &r);
+    assert_eq!(read(&stopped), read(&full));
+    assert_eq!(text(&stopped, "impacts.csv"), impacts);
+    assert_eq!(text(&stopped, "blocks.csv"), blocks);
+
+    // killed after a checkpoint, with more written since: resumed from the checkpoint
+    let killed = tmp.join("killed");
+    let died = std::panic::catch_unwind(|| {
+        stream::run(
+            &case.model,
+            &case.settings,
+            &killed,
+            &stream_settings(Some(4096)),
+            7,
+            &mut DieAt(7168),
+        )
+    });
+    assert!(died.is_err());
+    let r = resume(&case, &killed, 7).unwrap();
+    same_statistics(&r_full, &r);
+    assert_eq!(read(&killed), read(&full));
+    assert_eq!(text(&killed, "impacts.csv"), impacts);
+    assert_eq!(text(&killed, "blocks.csv"), blocks);
+
+    // another case (fingerprint) or a complete run: refused
+    let err = resume(&case, &full, 8).unwrap_err();
+    assert!(err.to_string().contains("another case"), "{err}");
+    let err = resume(&case, &full, 7).unwrap_err();
+    assert!(err.to_string().contains("complete"), "{err}");
+    std::fs::remove_dir_all(&tmp).ok();
+}
+
+/// Resumes the run in `dir` to its end.
+fn resume(case: &Case, dir: &Path, fingerprint: u64) -> fretdyn::Result<RunResults> {
+    stream::resume(
+        &case.model,
+        &case.settings,
+        dir,
+        &stream_settings(None),
+        fingerprint,
+        &mut ProgressOnly(|_| ControlFlow::Continue(())),
+    )
+}
+
+fn tempdir() -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("fretdyn-long-runs-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
