@@ -6,6 +6,7 @@ mod plot;
 mod progress;
 mod results_plots;
 mod run;
+mod sweep;
 mod verify;
 
 use std::path::PathBuf;
@@ -45,6 +46,22 @@ enum Command {
         /// Do not write PNG plots.
         #[arg(long)]
         no_plots: bool,
+    },
+    /// Run a parametric / Monte-Carlo study (a base case, parameters as a grid or a list,
+    /// seeds) on every core: one row per finished run in DIR/study.csv; run again after a
+    /// crash, the finished runs are skipped.
+    Sweep {
+        /// Study file (TOML), see examples/study_clearance.toml.
+        study: PathBuf,
+        /// Output folder [default: fretdyn_results/<study name>].
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Runs at a time [default: one per core].
+        #[arg(short, long, default_value_t = 0)]
+        jobs: usize,
+        /// No progress bar and no report.
+        #[arg(short, long)]
+        quiet: bool,
     },
     /// Draw the plots of a run folder again (forces, displacements, orbits in the holes,
     /// peak-force histograms, wear work rates).
@@ -130,6 +147,12 @@ fn main() -> ExitCode {
                 run::main(case.as_deref(), resume.as_deref(), &options)
             }
         }
+        Command::Sweep {
+            study,
+            output,
+            jobs,
+            quiet,
+        } => sweep::main(&study, output, jobs, quiet),
         Command::Plot { dir } => results_plots::plot_run(&dir).map(|files| {
             for f in files {
                 println!("wrote {}", f.display());

@@ -292,7 +292,7 @@ fn npz_f64(dir: &Path, key: &str) -> ndarray::ArrayD<f64> {
 
 /// The tube in its 5 plates under turbulence, 10 simulated seconds: run to the end; run again
 /// and `kill -9` it past half time; what it wrote is readable; `run --resume` finishes it with
-/// the results of the uninterrupted run, bit for bit.
+/// the results of the uninterrupted run, bit for bit. The same after Ctrl-C.
 #[test]
 fn turbulence_tube_killed_at_half_time_resumes_bit_for_bit() {
     let s = Scratch::new("resume");
@@ -395,4 +395,53 @@ fn turbulence_tube_killed_at_half_time_resumes_bit_for_bit() {
     let out = fretdyn(&["run", "--resume", "killed", "-q", "--no-plots"], &s.0);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("nothing to resume"));
+
+    // Ctrl-C (SIGINT): stops after a checkpoint, says how to continue, leaves results.npz
+    let child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args([
+            "run",
+            case,
+            "-o",
+            "interrupted",
+            "-q",
+            "--no-plots",
+            "--checkpoint-every",
+            "0.2",
+        ])
+        .current_dir(&s.0)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let interrupted = s.0.join("interrupted");
+    while checkpoint_step(&interrupted).is_none_or(|n| n < 200_000) {
+        assert!(start.elapsed().as_secs() < 1200, "no checkpoint");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("interrupted at step") && stderr.contains("--resume"),
+        "{stderr}"
+    );
+    let stopped = summary(&interrupted);
+    assert_eq!(stopped["termination"]["status"], "stopped");
+    let n = npz_f64(&interrupted, "t").len();
+    assert!(n > 1 && n < npz_f64(&full, "t").len());
+    let out = fretdyn(
+        &["run", "--resume", "interrupted", "-q", "--no-plots"],
+        &s.0,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(summary(&interrupted)["contacts"], a["contacts"]);
+    let (x, y) = (npz_f64(&full, "q"), npz_f64(&interrupted, "q"));
+    assert!(x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()));
 }

@@ -44,6 +44,7 @@ pub mod simulation;
 pub mod stability;
 pub mod statistics;
 pub mod stream;
+pub mod study;
 pub mod tangential;
 pub mod tube;
 pub mod turbulence;
