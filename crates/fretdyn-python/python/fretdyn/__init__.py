@@ -1,0 +1,173 @@
+"""fretdyn: nonlinear vibration of a structure on a modal basis rattling against obstacles with
+Coulomb friction (explicit central differences; penalty, Active Set or projected Gauss–Seidel).
+
+    import fretdyn
+    case = fretdyn.Case.from_file("examples/v1a_oblique_impact.toml")
+    r = fretdyn.run(case)            # numpy arrays, GIL released, Ctrl-C honoured
+    r["contact_normal_force"][:, 0], r["summary"]["contacts"][0]["wear_work_rate"]
+
+Cases come from a TOML file, TOML text, or a Python dict with the structure of a case file
+(numpy arrays are accepted anywhere a list is). Studies (`sweep`) run on every core, or on a
+Dask cluster when given a `dask.distributed.Client`.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+from pathlib import Path
+from typing import Any, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _native
+from ._native import FretdynError
+
+__all__ = ["Case", "FretdynError", "run", "sweep", "modal_structure", "__version__"]
+__version__ = _native.__version__
+
+PathLike = Union[str, os.PathLike]
+
+
+def _plain(value: Any) -> Any:
+    """numpy arrays and scalars → lists and Python numbers (for JSON)."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+class Case:
+    """A case: model and settings, ready to run. Build it with a class method."""
+
+    def __init__(self, native: "_native.Case"):
+        self._native = native
+
+    @classmethod
+    def from_file(cls, path: PathLike) -> "Case":
+        """Reads a case file (TOML); relative file names are resolved from its folder."""
+        return cls(_native.load_case(os.fspath(path)))
+
+    @classmethod
+    def from_toml(cls, text: str, base_dir: PathLike = ".") -> "Case":
+        """A case from TOML text."""
+        return cls(_native.case_from_toml(text, os.fspath(base_dir)))
+
+    @classmethod
+    def from_dict(cls, case: Mapping[str, Any], base_dir: PathLike = ".") -> "Case":
+        """A case from a dict with the keys of a case file (numpy arrays allowed)."""
+        return cls(_native.case_from_json(json.dumps(_plain(case)), os.fspath(base_dir)))
+
+    title = property(lambda self: self._native.title, doc="Title of the case.")
+    dt = property(lambda self: self._native.dt, doc="Time step, s.")
+    steps = property(lambda self: self._native.steps, doc="Number of steps.")
+    modes = property(lambda self: self._native.modes, doc="Number of modes.")
+    contact_names = property(lambda self: self._native.contact_names, doc="Contact names.")
+    frequencies_hz = property(
+        lambda self: np.array(self._native.frequencies_hz), doc="Natural frequencies, Hz."
+    )
+
+    def __repr__(self) -> str:
+        return repr(self._native)
+
+
+def modal_structure(
+    frequencies_hz: Sequence[float],
+    points: Mapping[str, Any],
+    damping_ratio: Optional[Sequence[float]] = None,
+    coords: Optional[Mapping[str, Sequence[float]]] = None,
+) -> dict:
+    """The `[structure]` of a case from numpy arrays: frequencies (p,), damping ratios (p,),
+    and for each point name its mass-normalised rows, shape (3, p) (x, y, z translations)."""
+    p = len(frequencies_hz)
+    structure: dict = {
+        "type": "modal",
+        "frequencies_hz": _plain(np.asarray(frequencies_hz, dtype=float)),
+        "damping_ratio": _plain(
+            np.zeros(p) if damping_ratio is None else np.asarray(damping_ratio, dtype=float)
+        ),
+        "points": [],
+    }
+    for name, rows in points.items():
+        rows = np.asarray(rows, dtype=float)
+        if rows.shape != (3, p):
+            raise FretdynError(f"structure.points.{name}: rows must have shape (3, {p}), got {rows.shape}")
+        point = {"name": name, "rows": _plain(rows)}
+        if coords and name in coords:
+            point["coords"] = _plain(np.asarray(coords[name], dtype=float))
+        structure["points"].append(point)
+    return structure
+
+
+def run(case: Case) -> dict:
+    """Runs a case (the GIL is released; Ctrl-C raises KeyboardInterrupt). Returns the arrays
+    of `results.npz` as numpy arrays and `summary`, the content of `summary.json` as a dict.
+    A diverged run returns what it computed; its `summary["termination"]` says where."""
+    out = _native.run(case._native)
+    out["summary"] = json.loads(out.pop("summary_json"))
+    return out
+
+
+def _read_done(table: Path, header: str) -> set:
+    if not table.exists() or table.stat().st_size == 0:
+        return set()
+    text = table.read_text()
+    lines = text.splitlines()
+    if lines[0] != header:
+        raise FretdynError(f"{table}: has another header: it belongs to another study")
+    complete = lines[1:] if text.endswith("\n") else lines[1:-1]
+    n = len(header.split(","))
+    return {int(l.split(",")[0]) for l in complete if len(l.split(",")) == n}
+
+
+def _row(study: str, index: int) -> str:
+    return _native.study_row(study, index)
+
+
+def sweep(study: PathLike, table: PathLike, client: Any = None, jobs: int = 0) -> int:
+    """Runs a study file (see `fretdyn sweep`) into the CSV `table`, one row per finished run,
+    skipping the runs already in it. Without `client`, on this machine, `jobs` runs at a time
+    (0: one per core). With a `dask.distributed.Client`, each run is a task on the cluster
+    (the workers need this package and the study's files) and rows are written as tasks
+    finish. Returns the number of runs done."""
+    study = os.fspath(os.path.abspath(study))
+    table = Path(table)
+    if client is None:
+        return _native.study_local(study, os.fspath(table), jobs)
+    from dask.distributed import as_completed
+
+    header = _native.study_header(study)
+    done = _read_done(table, header)
+    if table.exists() and table.stat().st_size > 0 and not table.read_text().endswith("\n"):
+        text = table.read_text()
+        table.write_text(text[: text.rfind("\n") + 1])
+    pending = [i for i in range(_native.study_runs(study)) if i not in done]
+    with open(table, "a", newline="") as f:
+        if not done and f.tell() == 0:
+            f.write(header + "\n")
+        futures = [client.submit(_row, study, i, pure=False) for i in pending]
+        for future in as_completed(futures):
+            f.write(future.result() + "\n")
+            f.flush()
+    return len(pending)
+
+
+def read_table(table: PathLike) -> dict:
+    """A study's table as a dict of numpy arrays (numbers) or lists (text), by column."""
+    with open(table, newline="") as f:
+        rows = list(csv.reader(f))
+    header, body = rows[0], [r for r in rows[1:] if len(r) == len(rows[0])]
+    out: dict = {}
+    for k, name in enumerate(header):
+        col = [r[k] for r in body]
+        try:
+            out[name] = np.array([float(v) if v else np.nan for v in col])
+        except ValueError:
+            out[name] = col
+    return out

@@ -1,0 +1,253 @@
+//! The native part of the Python package `fretdyn` (module `fretdyn._native`): cases from a
+//! TOML file, TOML text or JSON (Python dicts), runs with the GIL released and Ctrl-C honoured,
+//! results as numpy arrays, and the rows of studies for local or Dask execution. The
+//! Python-facing API is `python/fretdyn/__init__.py`.
+
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::PyKeyboardInterrupt;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+pyo3::create_exception!(
+    _native,
+    FretdynError,
+    pyo3::exceptions::PyValueError,
+    "Bad input or a failed run; the message names the file, the field and the fix, as the CLI's."
+);
+
+fn err(e: fretdyn::Error) -> PyErr {
+    FretdynError::new_err(e.to_string())
+}
+
+/// A case: model and settings, ready to run.
+#[pyclass(module = "fretdyn._native", frozen)]
+struct Case {
+    inner: fretdyn::case::Case,
+}
+
+#[pymethods]
+impl Case {
+    /// Title of the case.
+    #[getter]
+    fn title(&self) -> String {
+        self.inner.title.clone()
+    }
+
+    /// Time step, s.
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.inner.settings.dt
+    }
+
+    /// Number of steps.
+    #[getter]
+    fn steps(&self) -> u64 {
+        self.inner.settings.steps
+    }
+
+    /// Number of modes of the basis.
+    #[getter]
+    fn modes(&self) -> usize {
+        self.inner.model.basis.modes()
+    }
+
+    /// Names of the contacts, in the order of the results' contact axis.
+    #[getter]
+    fn contact_names(&self) -> Vec<String> {
+        self.inner
+            .model
+            .contacts
+            .iter()
+            .map(|c| c.name.clone())
+            .collect()
+    }
+
+    /// Natural frequencies of the basis, Hz.
+    #[getter]
+    fn frequencies_hz(&self) -> Vec<f64> {
+        self.inner
+            .model
+            .basis
+            .omega
+            .iter()
+            .map(|w| w / std::f64::consts::TAU)
+            .collect()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Case({:?}, {} modes, {} contacts, {} steps of {:e} s)",
+            self.inner.title,
+            self.modes(),
+            self.inner.model.contacts.len(),
+            self.steps(),
+            self.dt()
+        )
+    }
+}
+
+/// Reads a case file.
+#[pyfunction]
+fn load_case(path: PathBuf) -> PyResult<Case> {
+    fretdyn::case::Case::from_file(&path)
+        .map(|inner| Case { inner })
+        .map_err(|e| FretdynError::new_err(format!("{}: {e}", path.display())))
+}
+
+/// A case from TOML text; relative file names are resolved from `base_dir`.
+#[pyfunction]
+#[pyo3(signature = (text, base_dir = PathBuf::from(".")))]
+fn case_from_toml(text: &str, base_dir: PathBuf) -> PyResult<Case> {
+    fretdyn::case::Case::from_toml_str(text, &base_dir)
+        .map(|inner| Case { inner })
+        .map_err(err)
+}
+
+/// A case from JSON text with the structure of a case file (how Python dicts come in).
+#[pyfunction]
+#[pyo3(signature = (json, base_dir = PathBuf::from(".")))]
+fn case_from_json(json: &str, base_dir: PathBuf) -> PyResult<Case> {
+    let value: serde_json::Value = serde_json::from_str(json)
+        .map_err(|e| FretdynError::new_err(format!("the case is not valid JSON: {e}")))?;
+    let toml_value = toml::Value::try_from(value)
+        .map_err(|e| FretdynError::new_err(format!("the case cannot be written as TOML: {e}")))?;
+    let text = toml::to_string(&toml_value)
+        .map_err(|e| FretdynError::new_err(format!("the case cannot be written as TOML: {e}")))?;
+    case_from_toml(&text, base_dir)
+}
+
+/// Runs a case with the GIL released; Ctrl-C stops it (KeyboardInterrupt). Returns a dict of
+/// numpy arrays (the keys of `results.npz`) and `summary_json`, the text of `summary.json`.
+#[pyfunction]
+fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
+    let c = &case.inner;
+    let mut interrupted = None;
+    let results = py
+        .detach(|| {
+            fretdyn::simulation::run(&c.model, &c.settings, |_| {
+                // back in the interpreter for a moment, every 1024 steps, for Ctrl-C
+                match Python::attach(|py| py.check_signals()) {
+                    Ok(()) => ControlFlow::Continue(()),
+                    Err(e) => {
+                        interrupted = Some(e);
+                        ControlFlow::Break(())
+                    }
+                }
+            })
+        })
+        .map_err(err)?;
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    let out = PyDict::new(py);
+    let r = &results.recorder;
+    let f64_arrays: [(&str, Vec<f64>, Vec<usize>); 8] = [
+        ("t", r.t.to_vec(), r.t.shape().to_vec()),
+        ("q", r.q.iter().copied().collect(), r.q.shape().to_vec()),
+        (
+            "qdot",
+            r.qdot.iter().copied().collect(),
+            r.qdot.shape().to_vec(),
+        ),
+        (
+            "contact_normal_force",
+            r.normal_force.iter().copied().collect(),
+            r.normal_force.shape().to_vec(),
+        ),
+        (
+            "contact_tangential_force",
+            r.tangential_force.iter().copied().collect(),
+            r.tangential_force.shape().to_vec(),
+        ),
+        (
+            "contact_slip_velocity",
+            r.slip_velocity.iter().copied().collect(),
+            r.slip_velocity.shape().to_vec(),
+        ),
+        (
+            "contact_penetration",
+            r.penetration.iter().copied().collect(),
+            r.penetration.shape().to_vec(),
+        ),
+        (
+            "contact_position",
+            r.position.iter().copied().collect(),
+            r.position.shape().to_vec(),
+        ),
+    ];
+    for (key, data, shape) in f64_arrays {
+        out.set_item(key, PyArray1::from_vec(py, data).reshape(shape)?)?;
+    }
+    let status: Vec<i8> = r.status.iter().copied().collect();
+    out.set_item(
+        "contact_status",
+        PyArray1::from_vec(py, status).reshape(r.status.shape().to_vec())?,
+    )?;
+    let summary = fretdyn::output::summary(c, &results);
+    out.set_item("summary_json", summary.to_string())?;
+    if matches!(
+        results.termination,
+        fretdyn::simulation::Termination::Stopped { .. }
+    ) {
+        return Err(PyKeyboardInterrupt::new_err("the run was interrupted"));
+    }
+    Ok(out)
+}
+
+fn study(path: &Path) -> PyResult<fretdyn::study::Study> {
+    fretdyn::study::Study::from_file(path)
+        .map_err(|e| FretdynError::new_err(format!("{}: {e}", path.display())))
+}
+
+/// Number of runs of a study.
+#[pyfunction]
+fn study_runs(path: PathBuf) -> PyResult<usize> {
+    Ok(study(&path)?.runs().len())
+}
+
+/// Header line of a study's table.
+#[pyfunction]
+fn study_header(path: PathBuf) -> PyResult<String> {
+    let s = study(&path)?;
+    Ok(s.header(&s.contact_names()))
+}
+
+/// Runs run `index` of a study (GIL released) and returns its table row.
+#[pyfunction]
+fn study_row(py: Python<'_>, path: PathBuf, index: usize) -> PyResult<String> {
+    let s = study(&path)?;
+    let runs = s.runs();
+    let run = runs
+        .get(index)
+        .ok_or_else(|| FretdynError::new_err(format!("the study has {} runs", runs.len())))?;
+    py.detach(|| s.run_row(run)).map_err(err)
+}
+
+/// Runs a study on this machine, `jobs` runs at a time (0: one per core), into the table
+/// `table` (finished runs already in it are skipped); returns the number of runs done.
+#[pyfunction]
+#[pyo3(signature = (path, table, jobs = 0))]
+fn study_local(py: Python<'_>, path: PathBuf, table: PathBuf, jobs: usize) -> PyResult<usize> {
+    let s = study(&path)?;
+    py.detach(|| s.execute(&table, jobs, &|_, _| {}))
+        .map_err(err)
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("FretdynError", m.py().get_type::<FretdynError>())?;
+    m.add_class::<Case>()?;
+    m.add_function(wrap_pyfunction!(load_case, m)?)?;
+    m.add_function(wrap_pyfunction!(case_from_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(case_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(study_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(study_header, m)?)?;
+    m.add_function(wrap_pyfunction!(study_row, m)?)?;
+    m.add_function(wrap_pyfunction!(study_local, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,118 @@
+"""The Python package against the CLI and against itself: the same arrays bit for bit, errors
+as exceptions with the CLI's messages, cases from dicts and numpy arrays, and a study run on a
+Dask cluster of 2 worker processes equal to the same study run locally. Run by .ci/run in a
+venv where the package is installed (pip install ./crates/fretdyn-python)."""
+
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import fretdyn
+
+ROOT = Path(__file__).resolve().parents[3]
+EXAMPLES = ROOT / "examples"
+FRETDYN = os.environ.get("FRETDYN", str(ROOT / "target" / "release" / "fretdyn"))
+KEYS = [
+    "t", "q", "qdot", "contact_normal_force", "contact_tangential_force",
+    "contact_slip_velocity", "contact_penetration", "contact_status", "contact_position",
+]
+
+
+def cli(args, cwd):
+    return subprocess.run([FRETDYN, *args], cwd=cwd, capture_output=True, text=True)
+
+
+def same_bits(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def test_v1a_from_python_equals_the_cli_bit_for_bit(tmp_path):
+    case = EXAMPLES / "v1a_oblique_impact.toml"
+    p = cli(["run", str(case), "-o", "out", "-q", "--no-plots"], tmp_path)
+    assert p.returncode == 0, p.stderr
+    npz = np.load(tmp_path / "out" / "results.npz")
+    r = fretdyn.run(fretdyn.Case.from_file(case))
+    for k in KEYS:
+        assert same_bits(r[k], npz[k]), k
+    assert r["summary"]["contacts"][0]["name"] == "plane"
+    assert r["summary"]["termination"]["status"] == "completed"
+
+
+def test_errors_are_exceptions_with_the_cli_message(tmp_path):
+    text = (EXAMPLES / "v1a_oblique_impact.toml").read_text().replace("dt = 1e-6", "dt = 1e-2")
+    (tmp_path / "bad.toml").write_text(text)
+    p = cli(["run", "bad.toml", "-o", "out", "-q"], tmp_path)
+    assert p.returncode == 2
+    with pytest.raises(fretdyn.FretdynError) as e:
+        c = fretdyn.Case.from_file(tmp_path / "bad.toml")
+        fretdyn.run(c)
+    # the CLI prefixes the file name; the message is the same
+    assert p.stderr.strip() == f"error: bad.toml: {e.value}"
+    assert "time.dt" in str(e.value) and "stable limit" in str(e.value)
+    with pytest.raises(fretdyn.FretdynError, match="contacts.0.friction.mu|friction"):
+        fretdyn.Case.from_toml(text.replace("friction = { mu = 0.3 }", "friction = { mu = -1 }"))
+    with pytest.raises(fretdyn.FretdynError):
+        fretdyn.modal_structure([1.0, 2.0], {"a": np.zeros((3, 3))})
+
+
+def test_a_case_from_a_dict_and_numpy_arrays_equals_the_file():
+    file = fretdyn.Case.from_file(EXAMPLES / "v1a_modal_inline.toml")
+    a = np.radians(20.0)
+    case = {
+        "title": "V1a from Python",
+        "time": {"dt": 1e-6, "duration": 4e-3},
+        "structure": fretdyn.modal_structure(
+            np.zeros(3), {"mass": np.eye(3)}, coords={"mass": np.zeros(3)}
+        ),
+        "initial": {"point": "mass", "velocity": [np.sin(a), 0.0, -np.cos(a)]},
+        "contacts": [{
+            "name": "plane", "point": "mass",
+            "obstacle": {"type": "plane", "origin": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0],
+                         "gap": 0.0, "tangent": [1.0, 0.0, 0.0]},
+            "normal": {"stiffness": 1e6, "damping": 0.0},
+            "friction": {"mu": 0.3},
+        }],
+        "tangential": {"method": "gauss_seidel"},
+    }
+    r1, r2 = fretdyn.run(file), fretdyn.run(fretdyn.Case.from_dict(case))
+    for k in KEYS:
+        assert np.allclose(r1[k], r2[k], rtol=1e-12, atol=1e-15), k
+
+
+def study(tmp_path):
+    (tmp_path / "v1a.toml").write_text((EXAMPLES / "v1a_oblique_impact.toml").read_text())
+    path = tmp_path / "study.toml"
+    path.write_text(
+        'base = "v1a.toml"\n\n[[parameters]]\nkey = "contacts.*.friction.mu"\n'
+        "values = [0.1, 0.2, 0.3, 0.4]\n\n[[parameters]]\nkey = \"tangential.method\"\n"
+        'values = ["gauss_seidel", "active_set"]\n'
+    )
+    return path
+
+
+def rows(table):
+    lines = Path(table).read_text().splitlines()
+    body = sorted(lines[1:], key=lambda l: int(l.split(",")[0]))
+    # without steps_per_second (column 5): wall-clock dependent
+    return lines[0], [[c for i, c in enumerate(l.split(",")) if i != 5] for l in body]
+
+
+def test_a_sweep_on_a_dask_cluster_equals_the_local_sweep(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    path = study(tmp_path)
+    assert fretdyn.sweep(path, tmp_path / "local.csv", jobs=2) == 8
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        assert fretdyn.sweep(path, tmp_path / "dask.csv", client=client) == 8
+        # run again: nothing left to do
+        assert fretdyn.sweep(path, tmp_path / "dask.csv", client=client) == 0
+    local, dask = rows(tmp_path / "local.csv"), rows(tmp_path / "dask.csv")
+    assert local == dask
+    assert len(local[1]) == 8
+    t = fretdyn.read_table(tmp_path / "dask.csv")
+    assert np.all(t["plane.wear_work_rate"] > 0)
