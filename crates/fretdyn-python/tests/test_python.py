@@ -116,3 +116,59 @@ def test_a_sweep_on_a_dask_cluster_equals_the_local_sweep(tmp_path):
     assert len(local[1]) == 8
     t = fretdyn.read_table(tmp_path / "dask.csv")
     assert np.all(t["plane.wear_work_rate"] > 0)
+
+
+def long_case():
+    """The turbulent tube, 2 s: about a second of computing."""
+    return fretdyn.Case.from_toml(
+        (EXAMPLES / "tube_turbulence.toml").read_text().replace("duration = 10.0", "duration = 2.0"),
+        EXAMPLES,
+    )
+
+
+def test_the_gil_is_released_during_a_run():
+    import threading
+    import time
+
+    case = long_case()
+    done = threading.Event()
+    thread = threading.Thread(target=lambda: (fretdyn.run(case), done.set()))
+    start = time.perf_counter()
+    thread.start()
+    ticks = 0
+    while not done.is_set():
+        ticks += 1  # pure Python: runs only while the run does not hold the GIL
+        time.sleep(0.001)
+    thread.join()
+    elapsed = time.perf_counter() - start
+    assert elapsed > 0.2, elapsed
+    # the main thread kept running: at least a tick per 10 ms of the run
+    assert ticks > 0.1 * elapsed * 1000, (ticks, elapsed)
+
+
+def test_ctrl_c_stops_a_run_with_keyboard_interrupt(tmp_path):
+    import signal
+    import sys
+    import time
+
+    script = tmp_path / "long.py"
+    script.write_text(
+        "import sys, fretdyn\n"
+        f"text = open({str(EXAMPLES / 'tube_turbulence.toml')!r}).read()\n"
+        f"case = fretdyn.Case.from_toml(text.replace('duration = 10.0', 'duration = 100.0'), {str(EXAMPLES)!r})\n"
+        "print('running', flush=True)\n"
+        "try:\n"
+        "    fretdyn.run(case)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+        "    sys.exit(3)\n"
+    )
+    p = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "running"
+    time.sleep(1.0)
+    start = time.perf_counter()
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=60)
+    assert p.returncode == 3, out
+    assert "interrupted" in out
+    assert time.perf_counter() - start < 5.0
