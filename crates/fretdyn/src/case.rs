@@ -19,12 +19,13 @@ use crate::model::Model;
 use crate::motion::Motion;
 use crate::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
 use crate::simulation::RunSettings;
+use crate::spatial_correlation::{covariance_factor, line_covariance};
 use crate::statistics::StatisticsSettings;
 use crate::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
 use crate::tube::{Damping, NamedPoint, TubeBasis, TubeStructure, node_at};
-use crate::turbulence::{Spectrum, correlated_factor};
+use crate::turbulence::Spectrum;
 
 /// A parsed, validated case.
 #[derive(Debug, Clone)]
@@ -1123,9 +1124,9 @@ impl CaseFile {
                 .spectrum
                 .spectrum(t.structure.beam.tube.section.outer_diameter);
             let nodes = t.structure.line_nodes(&t.basis, s0, s1);
-            let positions: Vec<f64> = nodes.iter().map(|n| n.s).collect();
-            let weights: Vec<f64> = nodes.iter().map(|n| n.weight).collect();
-            let factor = correlated_factor(&positions, &weights, l.correlation_length, l.tolerance)
+            let (_, cells) = t.structure.line_cells(s0, s1);
+            let factor = line_covariance(nodes.len(), &cells, l.correlation_length)
+                .and_then(|c| covariance_factor(c, l.tolerance))
                 .map_err(|e| match e {
                     Error::Invalid { field: f, message } => {
                         Error::invalid(format!("{field}.{f}"), message)

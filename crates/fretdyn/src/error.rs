@@ -54,6 +54,15 @@ impl Error {
         }
     }
 
+    /// The offending field of an [`Error::Invalid`] (e.g. `turbulence[0].correlation_length`),
+    /// `None` for other errors.
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            Error::Invalid { field, .. } => Some(field),
+            _ => None,
+        }
+    }
+
     pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),

@@ -41,6 +41,7 @@ pub mod obstacle;
 pub mod output;
 pub mod recorder;
 pub mod simulation;
+pub mod spatial_correlation;
 pub mod stability;
 pub mod statistics;
 pub mod stream;

@@ -263,7 +263,7 @@ fn check_history(history: &TimeHistory, field: &str) -> Result<()> {
 /// one-sided PSD `S(f)` ([`crate::turbulence::RandomChannels`], seeded, a pure function of
 /// time), each loading the modes along a fixed vector `g_j`: `f_q(t) = Σ_j ξ_j(t) g_j`.
 /// For a tube, `g_j = Σ_i L_ij Φ_iᵀ e` with `L` the factor of the spatial correlation
-/// ([`crate::turbulence::correlated_factor`]) of the nodes along the span, and `e` a
+/// ([`crate::spatial_correlation::line_covariance`]) of the nodes along the span, and `e` a
 /// direction of the force.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TurbulentLoad {

@@ -14,6 +14,7 @@ use crate::eigen::{ModeSelection, Modes, lowest_modes};
 use crate::error::{Error, Result};
 use crate::modal::{ModalBasis, Point};
 use crate::model::{Model, PhysicalMatrices};
+use crate::spatial_correlation::LineCell;
 
 /// A named point of the tube: a node, and an offset from the axis.
 #[derive(Debug, Clone, PartialEq)]
@@ -171,17 +172,14 @@ impl TubeStructure {
             .sum()
     }
 
-    /// The nodes carrying a line load on the arc-length span `[s0, s1]`: each element's
-    /// overlap with the span, of length `ℓ` and centroid `c`, is shared between its end nodes
-    /// `a`, `b` as `ℓ (s_b − c)/(s_b − s_a)` and `ℓ (c − s_a)/(s_b − s_a)` (same resultant
-    /// and same first moment as the uniform load). Nodes with no share are left out.
-    pub fn line_nodes(&self, basis: &TubeBasis, s0: f64, s1: f64) -> Vec<LineNode> {
+    /// The elements under a line load on the arc-length span `[s0, s1]`, clipped to it, and
+    /// the mesh node of each row they refer to (the nodes with a share of the load, in mesh
+    /// order). Arc lengths run along the elements from the tube's first node.
+    pub fn line_cells(&self, s0: f64, s1: f64) -> (Vec<usize>, Vec<LineCell>) {
         let mesh = &self.beam.mesh;
-        let n = mesh.nodes.len();
-        // arc length of each node along the elements (numbered along the tube)
-        let mut s = vec![0.0; n];
-        let mut weight = vec![0.0; n];
+        let mut s = vec![0.0; mesh.nodes.len()];
         let mut acc = 0.0;
+        let mut pieces = Vec::new();
         for [a, b] in &mesh.elements {
             let len = (mesh.nodes[*b] - mesh.nodes[*a]).norm();
             s[*a] = acc;
@@ -189,26 +187,65 @@ impl TubeStructure {
             s[*b] = acc;
             let (lo, hi) = (s[*a].max(s0), s[*b].min(s1));
             if hi > lo && len > 0.0 {
-                let (l, c) = (hi - lo, 0.5 * (lo + hi));
-                weight[*a] += l * (s[*b] - c) / len;
-                weight[*b] += l * (c - s[*a]) / len;
+                pieces.push(([*a, *b], [s[*a], s[*b]], [lo, hi]));
             }
         }
-        (0..n)
-            .filter(|&i| weight[i] > 0.0)
-            .map(|i| {
+        let mut row = vec![usize::MAX; mesh.nodes.len()];
+        for (nodes, _, _) in &pieces {
+            for &i in nodes {
+                row[i] = 0;
+            }
+        }
+        let mut rows = Vec::new();
+        for (i, r) in row.iter_mut().enumerate() {
+            if *r == 0 {
+                *r = rows.len();
+                rows.push(i);
+            }
+        }
+        let cells = pieces
+            .into_iter()
+            .map(|([a, b], ends, loaded)| LineCell {
+                nodes: [row[a], row[b]],
+                ends,
+                loaded,
+            })
+            .collect();
+        (rows, cells)
+    }
+
+    /// The nodes carrying a line load on the arc-length span `[s0, s1]` (those of
+    /// [`TubeStructure::line_cells`]): each element's overlap with the span, of length `ℓ`
+    /// and centroid `c`, is shared between its end nodes `a`, `b` as `ℓ (s_b − c)/(s_b − s_a)`
+    /// and `ℓ (c − s_a)/(s_b − s_a)` (`∫ N_a`, `∫ N_b`: same resultant and same first moment
+    /// as the uniform load).
+    pub fn line_nodes(&self, basis: &TubeBasis, s0: f64, s1: f64) -> Vec<LineNode> {
+        let (rows, cells) = self.line_cells(s0, s1);
+        let mut nodes: Vec<LineNode> = rows
+            .iter()
+            .map(|&node| {
                 let pt = NamedPoint {
                     name: String::new(),
-                    node: i,
+                    node,
                     offset: Vector3::zeros(),
                 };
                 LineNode {
-                    s: s[i],
-                    weight: weight[i],
+                    s: 0.0,
+                    weight: 0.0,
                     rows: point_rows(&basis.assembled, &basis.modes.shapes, &pt),
                 }
             })
-            .collect()
+            .collect();
+        for cell in &cells {
+            let ([sa, sb], [lo, hi]) = (cell.ends, cell.loaded);
+            let (l, c) = (hi - lo, 0.5 * (lo + hi));
+            let [a, b] = cell.nodes;
+            nodes[a].s = sa;
+            nodes[b].s = sb;
+            nodes[a].weight += l * (sb - c) / (sb - sa);
+            nodes[b].weight += l * (c - sa) / (sb - sa);
+        }
+        nodes
     }
 }
 

@@ -1,23 +1,21 @@
 //! Random turbulence loads: a one-sided power spectral density of a force per unit length
-//! ([`Spectrum`]), `r` independent stationary Gaussian signals with that spectrum that are a
-//! pure function of time ([`RandomChannels`]), and the spatial correlation of the force along
-//! the tube ([`correlated_factor`]). `docs/LOADS.md`, section "Random turbulence", states the
+//! ([`Spectrum`]) and `r` independent stationary Gaussian signals with that spectrum that are a
+//! pure function of time ([`RandomChannels`]). Their spatial correlation along the tube is
+//! [`crate::spatial_correlation`]. `docs/LOADS.md`, section "Random turbulence", states the
 //! models, their sources and the measured accuracy.
 //!
 //! The nodal turbulent force is
 //!
 //! ```text
-//! F_i(t) = Σ_j L_ij ξ_j(t),      L Lᵀ ≈ C,   C_ik = w_i w_k exp(−|x_i − x_k| / λ)
+//! F_i(t) = Σ_j L_ij ξ_j(t),      L Lᵀ ≈ C,   C_ik = ∫∫ N_i(s) N_k(s') exp(−|s − s'| / λ) ds ds'
 //! ```
 //!
 //! with `ξ_j` the unit-less channels of [`RandomChannels`] (one-sided PSD `S(f)`), so that the
-//! cross-PSD of the nodal forces is `S(f) w_i w_k exp(−|x_i − x_k|/λ)` (`w_i` = length of tube
-//! attached to node `i`).
+//! cross-PSD of the nodal forces is `S(f) C_ik` (`N_i` the shape function of node `i`).
 
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
 
-use nalgebra::DMatrix;
 use rustfft::num_complex::Complex;
 use rustfft::{Fft, FftPlannerScalar};
 
@@ -47,7 +45,7 @@ pub enum Spectrum {
     /// with Code_Aster's defaults `Φ₀ = 1.5e-3`, `β = 2.7`, `f_Rc = 0.1`
     /// ([`Spectrum::cross_flow`]). Integrated over `[0, ∞)`:
     /// `σ² = (½ρV²D)² Φ₀ f_Rc (π/β) / sin(π/β)` (β > 1). The spatial correlation that goes with
-    /// it is `exp(−|Δx|/λ)` ([`correlated_factor`]); Code_Aster gives `λ` as a multiple of `D`.
+    /// it is `exp(−|Δx|/λ)` ([`crate::spatial_correlation`]); Code_Aster gives `λ` as a multiple of `D`.
     ///
     /// The formula is evaluated as written and taken as one-sided. Code_Aster defines its
     /// interspectra as two-sided transforms; if these defaults follow that convention, the
@@ -479,7 +477,7 @@ impl RandomChannels {
                 format!("{field}.channels"),
                 format!(
                     "{channels} channels × {} cached samples exceed {MAX_CACHE} values: \
-                     use fewer channels (a larger correlated_factor tolerance) or a shorter \
+                     use fewer channels (a larger tolerance) or a shorter \
                      block_length",
                     block_length + 1
                 ),
@@ -767,128 +765,12 @@ fn normal_pair(key: u64, pair: u64) -> (f64, f64) {
     (r * c, r * s)
 }
 
-/// Factor `L` (n × m, `m` ≤ n) with `L Lᵀ ≈ C`, `C_ik = w_i w_k exp(−|x_i − x_k|/λ)`, from the
-/// symmetric eigen-decomposition `C = Σ μ_p v_p v_pᵀ`: the columns `√μ_p v_p` of the fewest
-/// largest eigenvalues whose sum reaches `(1 − tolerance) tr C` (`tolerance = 0` keeps every
-/// eigenvalue above the round-off level `8 n ε tr C`). Each column has its largest entry
-/// positive.
-///
-/// `positions` `x_i` (m) and `weights` `w_i` (the length of tube attached to node `i`, m) give
-/// nodal forces `F_i = Σ_j L_ij ξ_j(t)` with cross-PSD `S(f) w_i w_k exp(−|x_i − x_k|/λ)` when
-/// the `ξ_j` are independent with PSD `S` ([`RandomChannels`]). `λ = ∞` (fully correlated)
-/// gives rank 1, `λ = 0` independent nodes (`L = diag(w)` up to column order). An all-zero
-/// `w` gives one zero column. Input errors name the argument (`positions`, `weights`,
-/// `correlation_length`, `tolerance`).
-///
-/// `w_i w_k exp(−|x_i − x_k|/λ)` lumps the force of each tube cell on its node: it overstates
-/// the nodal variance unless the cells are short compared with `λ` (by 3 % at `w = λ/10`).
-pub fn correlated_factor(
-    positions: &[f64],
-    weights: &[f64],
-    correlation_length: f64,
-    tolerance: f64,
-) -> Result<DMatrix<f64>> {
-    let n = positions.len();
-    if n == 0 {
-        return Err(Error::invalid("positions", "needs at least one node"));
-    }
-    if weights.len() != n {
-        return Err(Error::invalid(
-            "weights",
-            format!(
-                "must have one weight per position: {} weights for {} positions",
-                weights.len(),
-                n
-            ),
-        ));
-    }
-    if let Some(i) = positions.iter().position(|x| !x.is_finite()) {
-        return Err(Error::invalid(
-            format!("positions[{i}]"),
-            format!("must be a finite abscissa in m (got {})", positions[i]),
-        ));
-    }
-    if let Some(i) = weights.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
-        return Err(Error::invalid(
-            format!("weights[{i}]"),
-            format!("must be a finite tube length ≥ 0 in m (got {})", weights[i]),
-        ));
-    }
-    if !(correlation_length >= 0.0) {
-        return Err(Error::invalid(
-            "correlation_length",
-            format!(
-                "must be ≥ 0 in m (0: independent nodes, infinity: fully correlated), got \
-                 {correlation_length}"
-            ),
-        ));
-    }
-    if !(tolerance.is_finite() && (0.0..1.0).contains(&tolerance)) {
-        return Err(Error::invalid(
-            "tolerance",
-            format!(
-                "must be in [0, 1): the fraction of the trace the truncated factor may miss \
-                 (got {tolerance})"
-            ),
-        ));
-    }
-    let trace: f64 = weights.iter().map(|w| w * w).sum();
-    if trace == 0.0 {
-        return Ok(DMatrix::zeros(n, 1));
-    }
-    let c = DMatrix::from_fn(n, n, |i, k| {
-        let dx = (positions[i] - positions[k]).abs();
-        let rho = if dx == 0.0 {
-            1.0
-        } else {
-            (-dx / correlation_length).exp()
-        };
-        weights[i] * weights[k] * rho
-    });
-    let eig = nalgebra::SymmetricEigen::new(c);
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
-    let target = (1.0 - tolerance) * trace;
-    // Eigenvalues at the level of the round-off of the decomposition are zeros.
-    let negligible = 8.0 * n as f64 * f64::EPSILON * trace;
-    let mut kept = 0;
-    let mut sum = 0.0;
-    for &p in &order {
-        let mu = eig.eigenvalues[p];
-        if !(mu > negligible) {
-            break;
-        }
-        kept += 1;
-        sum += mu;
-        if sum >= target {
-            break;
-        }
-    }
-    let kept = kept.max(1);
-    let mut l = DMatrix::zeros(n, kept);
-    for (col, &p) in order.iter().take(kept).enumerate() {
-        let v = eig.eigenvectors.column(p);
-        let scale = eig.eigenvalues[p].max(0.0).sqrt();
-        let big = v
-            .iter()
-            .fold(0.0_f64, |m, &x| if x.abs() > m.abs() { x } else { m });
-        let sign = if big < 0.0 { -1.0 } else { 1.0 };
-        for i in 0..n {
-            l[(i, col)] = sign * scale * v[i];
-        }
-    }
-    Ok(l)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn field_of(e: Error) -> String {
-        match e {
-            Error::Invalid { field, .. } => field,
-            other => panic!("expected an input error, got {other}"),
-        }
+        e.field().expect("an input error").to_string()
     }
 
     fn table(f: &[f64], s: &[f64]) -> Spectrum {
@@ -1010,36 +892,6 @@ mod tests {
         let e = RandomChannels::from_psd(|_| -1.0, 1, 1, &GeneratorSettings::new(100.0), "t")
             .unwrap_err();
         assert_eq!(field_of(e), "t.psd");
-    }
-
-    #[test]
-    fn turbulence_correlated_factor_validation() {
-        let x = [0.0, 1.0];
-        let w = [1.0, 1.0];
-        let e = |r: Result<DMatrix<f64>>| field_of(r.unwrap_err());
-        assert_eq!(e(correlated_factor(&[], &[], 1.0, 0.0)), "positions");
-        assert_eq!(e(correlated_factor(&x, &[1.0], 1.0, 0.0)), "weights");
-        assert_eq!(
-            e(correlated_factor(&[0.0, f64::NAN], &w, 1.0, 0.0)),
-            "positions[1]"
-        );
-        assert_eq!(
-            e(correlated_factor(&x, &[1.0, -1.0], 1.0, 0.0)),
-            "weights[1]"
-        );
-        assert_eq!(
-            e(correlated_factor(&x, &w, -1.0, 0.0)),
-            "correlation_length"
-        );
-        assert_eq!(
-            e(correlated_factor(&x, &w, f64::NAN, 0.0)),
-            "correlation_length"
-        );
-        assert_eq!(e(correlated_factor(&x, &w, 1.0, 1.0)), "tolerance");
-        assert_eq!(e(correlated_factor(&x, &w, 1.0, -0.1)), "tolerance");
-        let zero = correlated_factor(&x, &[0.0, 0.0], 1.0, 0.0).unwrap();
-        assert_eq!(zero.shape(), (2, 1));
-        assert!(zero.iter().all(|&v| v == 0.0));
     }
 
     #[test]

@@ -8,6 +8,7 @@ use std::path::Path;
 
 use fretdyn::case::Case;
 use fretdyn::load::TimeHistory;
+use fretdyn::spatial_correlation::line_covariance;
 
 fn tube_case(extra: &str) -> String {
     format!(
@@ -161,8 +162,9 @@ fn sums_of_sines_add_their_terms() {
 
 /// The modal vectors `g_dj` of a turbulent load reproduce, summed over their channels, the
 /// modal cross-spectral matrix of the definition: `Σ_j g_dj g_djᵀ = Φ_eᵀ C Φ_e` with
-/// `C_ik = w_i w_k exp(−|s_i − s_k|/λ)` over the nodes of the span (up to the truncation
-/// tolerance), and the two directions load separate modes.
+/// `C_ik = ∫∫ N_i(s) N_k(s') exp(−|s − s'|/λ) ds ds'` over the nodes of the span
+/// (`line_covariance`, itself checked against closed forms and a brute-force sum), up to the
+/// truncation tolerance, and the two directions load separate modes.
 #[test]
 fn turbulence_modal_vectors_reproduce_the_spatial_covariance() {
     let lambda = 0.2;
@@ -180,12 +182,14 @@ fn turbulence_modal_vectors_reproduce_the_spatial_covariance() {
         (total - 1.5).abs() < 1e-12,
         "tributary lengths sum to the span: {total}"
     );
+    let (_, cells) = tube.structure.line_cells(0.5, 2.0);
+    let cov = line_covariance(nodes.len(), &cells, lambda).unwrap();
     for (dir, axis) in [(0usize, 1usize), (1, 2)] {
         // Φ_eᵀ C Φ_e from the definition
         let mut expected = vec![0.0; p * p];
-        for a in &nodes {
-            for b in &nodes {
-                let c = a.weight * b.weight * (-(a.s - b.s).abs() / lambda).exp();
+        for (ia, a) in nodes.iter().enumerate() {
+            for (ib, b) in nodes.iter().enumerate() {
+                let c = cov[(ia, ib)];
                 for i in 0..p {
                     for k in 0..p {
                         expected[i * p + k] += a.rows[axis * p + i] * c * b.rows[axis * p + k];
