@@ -692,6 +692,8 @@ struct PenaltyInput {
 struct GaussSeidelInput {
     #[serde(default = "default_tolerance")]
     tolerance: f64,
+    #[serde(default = "default_residual_tolerance")]
+    residual_tolerance: f64,
     #[serde(default = "default_max_sweeps")]
     max_sweeps: usize,
     #[serde(default)]
@@ -705,6 +707,7 @@ impl Default for GaussSeidelInput {
         let d = GaussSeidelSettings::default();
         Self {
             tolerance: d.tolerance,
+            residual_tolerance: d.residual_tolerance,
             max_sweeps: d.max_sweeps,
             local_solve: LocalSolveName::Exact,
             warm_start: d.warm_start,
@@ -714,6 +717,9 @@ impl Default for GaussSeidelInput {
 
 fn default_tolerance() -> f64 {
     GaussSeidelSettings::default().tolerance
+}
+fn default_residual_tolerance() -> f64 {
+    GaussSeidelSettings::default().residual_tolerance
 }
 fn default_max_sweeps() -> usize {
     GaussSeidelSettings::default().max_sweeps
@@ -1266,6 +1272,7 @@ impl GaussSeidelInput {
     fn settings(&self) -> GaussSeidelSettings {
         GaussSeidelSettings {
             tolerance: self.tolerance,
+            residual_tolerance: self.residual_tolerance,
             max_sweeps: self.max_sweeps,
             local_solve: match self.local_solve {
                 LocalSolveName::Exact => LocalSolve::Exact,

@@ -118,41 +118,67 @@ pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
 /// The slip solution on the circle of radius `s`: `λ = s u`, `|u| = 1`, `(s H + t I) u = c`,
 /// `t > 0` (then `w = c − Hλ = t u` is along `λ`). In the eigenbasis of `H` the condition is
 /// the secular equation `Σ c_k²/(s h_k + t)² = 1`, solved by Newton on `φ(t) = 1/|u(t)| − 1`,
-/// which is concave and increasing so Newton from `t = 0` converges monotonically.
+/// which is concave and increasing on `t > −s h_min`: from below the root Newton climbs to it
+/// monotonically, from above its first step lands below it.
+///
+/// The start is the lower bound `t* ≥ |c| − s h_max` (from `|c| = |(sH + tI)u| ≤ s h_max + t`).
+/// The bound is tight when `c` lies along the stiff eigenvector (a tube sliding round a hole,
+/// `H` anisotropic by 10³), so round-off may put the start just above the root: Newton then
+/// steps down to it (an earlier version projected radially there instead, off by up to 1e-4
+/// in direction).
 fn disk_boundary_solve(h: &Matrix2<f64>, c: &Vector2<f64>, s: f64) -> Vector2<f64> {
     let (q, eigenvalues) = symmetric_eigen2(h);
     let hs = [s * eigenvalues[0], s * eigenvalues[1]];
     let cp = q.transpose() * c;
-    let norm_u = |t: f64| {
-        let a = cp[0] / (hs[0] + t);
-        let b = cp[1] / (hs[1] + t);
-        (a * a + b * b).sqrt()
+    // u(t) in the eigenbasis; a component of c that is exactly 0 stays 0 (also at t = lower).
+    let u_of = |t: f64| {
+        let part = |k: usize| {
+            if cp[k] == 0.0 {
+                0.0
+            } else {
+                cp[k] / (hs[k] + t)
+            }
+        };
+        [part(0), part(1)]
     };
-    // Start below the root: |c| = |(sH + tI)u| ≤ s h_max + t gives t* ≥ |c| − s h_max.
-    let mut t = (-hs[0].min(hs[1]))
-        .max(c.norm() - hs[0].max(hs[1]))
-        .max(0.0);
-    if !(norm_u(t) > 1.0) {
-        // Only possible through round-off at the disk edge: project radially.
-        let free = solve2(h, c);
-        let n = free.norm();
-        return if n > 0.0 { free * (s / n) } else { free };
+    let lower = -hs[0].min(hs[1]);
+    let mut t = lower.max(c.norm() - hs[0].max(hs[1])).max(0.0);
+    if t <= lower {
+        // on the pole of a singular H: start just above it
+        t = lower + f64::EPSILON * (c.norm() + hs[0].abs().max(hs[1].abs()));
     }
     for _ in 0..100 {
-        let a = cp[0] / (hs[0] + t);
-        let b = cp[1] / (hs[1] + t);
+        let [a, b] = u_of(t);
         let n2 = a * a + b * b;
         let n = n2.sqrt();
         let phi = 1.0 / n - 1.0;
         let dphi = (a * a / (hs[0] + t) + b * b / (hs[1] + t)) / (n2 * n);
         let step = phi / dphi;
-        t -= step;
+        if !step.is_finite() {
+            break;
+        }
+        let next = t - step;
+        // Stay in the domain t > lower (a flat tangent far above the root could leave it).
+        t = if next > lower {
+            next
+        } else {
+            0.5 * (t + lower)
+        };
         if step.abs() <= 1e-15 * t.abs().max(f64::MIN_POSITIVE) {
             break;
         }
     }
-    let u = q * Vector2::new(cp[0] / (hs[0] + t), cp[1] / (hs[1] + t));
-    u * (s / u.norm())
+    let [a, b] = u_of(t);
+    let u = q * Vector2::new(a, b);
+    let n = u.norm();
+    if n.is_finite() && n > 0.0 {
+        u * (s / n)
+    } else {
+        // Degenerate input (c = 0 cannot slide): project the free solution radially.
+        let free = solve2(h, c);
+        let nf = free.norm();
+        if nf > 0.0 { free * (s / nf) } else { free }
+    }
 }
 
 /// Eigen-decomposition `H = Q diag(h) Qᵀ` of a symmetric 2 × 2 matrix, in closed form
@@ -235,5 +261,46 @@ mod tests {
         let (lam, st) = local_solve(&h, &c, 1.0, 0.5, LocalSolve::Exact);
         assert_eq!(st, Slide::Stick);
         assert_eq!(lam, c);
+    }
+
+    /// A tube sliding round a hole: `H` anisotropic (eigenvalues 3.0 and 4.7e-3, circumferential
+    /// and axial), `c` almost along the stiff eigenvector, so that the start of the Newton
+    /// iteration is at the root within round-off (a step of the tube case under turbulence).
+    /// The slip direction must be that of `c − Hλ` to round-off; the reference root `t` is
+    /// found by bisection on `|(sH + tI)⁻¹ c| = 1`, independently of the eigen-decomposition.
+    #[test]
+    fn exact_local_solve_when_the_start_is_at_the_root() {
+        let h = Matrix2::new(
+            3.017911803129995,
+            -0.0007964053757638976,
+            -0.0007964053757638976,
+            0.004689538498432074,
+        );
+        let c = Vector2::new(3378.686345562826, -0.8927309287548405);
+        let s = 0.2077213738615471;
+        let (lam, st) = local_solve(&h, &c, s, s, LocalSolve::Exact);
+        assert_eq!(st, Slide::Slip);
+        let w = c - h * lam;
+        let cross = (lam.x * w.y - lam.y * w.x) / (lam.norm() * w.norm());
+        assert!(
+            cross.abs() < 1e-12,
+            "λ not along the slip velocity: sin = {cross:.1e}"
+        );
+        assert!(lam.dot(&w) > 0.0 && (lam.norm() - s).abs() < 1e-15);
+        let size = |t: f64| {
+            (h * s + Matrix2::identity() * t)
+                .lu()
+                .solve(&c)
+                .unwrap()
+                .norm()
+        };
+        let (mut lo, mut hi) = (3000.0, 4000.0);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if size(mid) > 1.0 { lo = mid } else { hi = mid }
+        }
+        let u = (h * s + Matrix2::identity() * lo).lu().solve(&c).unwrap();
+        let reference = u * (s / u.norm());
+        assert!((lam - reference).norm() < 1e-13 * s, "{lam} vs {reference}");
     }
 }

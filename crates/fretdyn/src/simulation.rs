@@ -99,6 +99,16 @@ fn check_gs(g: &crate::tangential::GaussSeidelSettings, field: &str) -> Result<(
             ),
         ));
     }
+    if !(g.residual_tolerance.is_finite() && g.residual_tolerance > 0.0) {
+        return Err(Error::invalid(
+            format!("{field}.residual_tolerance"),
+            format!(
+                "must be a positive bound on the relative natural-map residual, e.g. 1e-8 \
+                 (got {})",
+                g.residual_tolerance
+            ),
+        ));
+    }
     if g.max_sweeps == 0 {
         return Err(Error::invalid(
             format!("{field}.max_sweeps"),
@@ -920,6 +930,7 @@ impl<'m> Simulation<'m> {
             };
         }
         self.solver_stats.lagrange_steps += 1;
+        let mut residual = None;
         match solver {
             LagrangeSolver::GaussSeidel(s) => {
                 // Gauss–Seidel tolerates a singular H (the modal forces are unique, λ is
@@ -934,6 +945,7 @@ impl<'m> Simulation<'m> {
                 if !sweeps.converged {
                     self.solver_stats.gs_nonconverged_steps += 1;
                 }
+                residual = sweeps.residual;
             }
             LagrangeSolver::ActiveSet(a) => {
                 a.solve(
@@ -945,8 +957,9 @@ impl<'m> Simulation<'m> {
                 );
             }
         }
-        self.solver_stats
-            .add_residual(problem.natural_map_residual(&lambda[..m], &slide[..m]));
+        let residual =
+            residual.unwrap_or_else(|| problem.natural_map_residual(&lambda[..m], &slide[..m]));
+        self.solver_stats.add_residual(residual);
         problem.apply(&lambda[..m], &mut self.cd.qdd);
         history.iter_mut().for_each(|h| h.closed = false);
         for (k, slot) in problem.slots().iter().enumerate() {

@@ -426,6 +426,10 @@ fn solve_gs(problem: &TangentialProblem) -> Vec<Vector2<f64>> {
         sweeps.converged,
         "Gauss–Seidel did not converge: {sweeps:?}"
     );
+    // converged means both tests passed: the residual it reports is that of its λ
+    let residual = problem.natural_map_residual(&lambda, &slide);
+    assert_eq!(sweeps.residual, Some(residual));
+    assert!(residual <= settings.residual_tolerance, "{residual}");
     lambda
 }
 

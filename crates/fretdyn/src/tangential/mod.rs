@@ -44,8 +44,12 @@ pub struct PenaltySettings {
 /// Projected Gauss–Seidel parameters (THEORY §4.4).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct GaussSeidelSettings {
-    /// Stop when `‖λ^{k+1} − λ^k‖ ≤ tol ‖λ^{k+1}‖`.
+    /// Stop when `‖λ^{k+1} − λ^k‖ ≤ tol ‖λ^{k+1}‖`...
     pub tolerance: f64,
+    /// ... and the natural-map residual
+    /// ([`TangentialProblem::natural_map_residual`](crate::delassus::TangentialProblem::natural_map_residual))
+    /// is at most this.
+    pub residual_tolerance: f64,
     /// Sweep bound; a step that reaches it is counted as non-converged.
     pub max_sweeps: usize,
     /// Exact block solve (default) or the paper's radial projection.
@@ -59,6 +63,7 @@ impl Default for GaussSeidelSettings {
     fn default() -> Self {
         Self {
             tolerance: 1e-12,
+            residual_tolerance: 1e-8,
             max_sweeps: 1000,
             local_solve: LocalSolve::Exact,
             warm_start: true,
