@@ -121,11 +121,13 @@ pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
 /// which is concave and increasing on `t > −s h_min`: from below the root Newton climbs to it
 /// monotonically, from above its first step lands below it.
 ///
-/// The start is the lower bound `t* ≥ |c| − s h_max` (from `|c| = |(sH + tI)u| ≤ s h_max + t`).
-/// The bound is tight when `c` lies along the stiff eigenvector (a tube sliding round a hole,
-/// `H` anisotropic by 10³), so round-off may put the start just above the root: Newton then
-/// steps down to it (an earlier version projected radially there instead, off by up to 1e-4
-/// in direction).
+/// The root lies between `|c| − s h_max` and `|c| − s h_min` (from
+/// `|c| = |(sH + tI)u|`, `|u| = 1`); the start is `|c|` minus the mean of the `s h_k` weighted
+/// by the components of `c`, exact to first order in `s h / t`, kept above the lower bound.
+/// A start above the root (it may be, and the lower bound itself may be by round-off when
+/// `c` lies along the stiff eigenvector of an `H` anisotropic by 10³, a tube sliding round a
+/// hole) costs Newton one step down (an earlier version projected radially when the start
+/// was not below the root, off by up to 1e-4 in direction).
 fn disk_boundary_solve(h: &Matrix2<f64>, c: &Vector2<f64>, s: f64) -> Vector2<f64> {
     let (q, eigenvalues) = symmetric_eigen2(h);
     let hs = [s * eigenvalues[0], s * eigenvalues[1]];
@@ -142,18 +144,28 @@ fn disk_boundary_solve(h: &Matrix2<f64>, c: &Vector2<f64>, s: f64) -> Vector2<f6
         [part(0), part(1)]
     };
     let lower = -hs[0].min(hs[1]);
-    let mut t = lower.max(c.norm() - hs[0].max(hs[1])).max(0.0);
+    // The root lies in [|c| − s h_max, |c| − s h_min]; start from |c| minus the mean of s h_k
+    // weighted by c's components, exact to first order in s h/t (a fast slip).
+    let c2 = cp[0] * cp[0] + cp[1] * cp[1];
+    let first_order = c2.sqrt() - (cp[0] * cp[0] * hs[0] + cp[1] * cp[1] * hs[1]) / c2;
+    let mut t = lower
+        .max(c.norm() - hs[0].max(hs[1]))
+        .max(0.0)
+        .max(first_order);
     if t <= lower {
         // on the pole of a singular H: start just above it
         t = lower + f64::EPSILON * (c.norm() + hs[0].abs().max(hs[1].abs()));
     }
     for _ in 0..100 {
-        let [a, b] = u_of(t);
+        // φ = 1/|u| − 1, φ' = Σ u_k²/(s h_k + t) / |u|³, so the Newton step φ/φ' is
+        // |u|²(1 − |u|) / Σ u_k²/(s h_k + t): three divisions.
+        let (r0, r1) = (1.0 / (hs[0] + t), 1.0 / (hs[1] + t));
+        let (a, b) = (
+            if cp[0] == 0.0 { 0.0 } else { cp[0] * r0 },
+            if cp[1] == 0.0 { 0.0 } else { cp[1] * r1 },
+        );
         let n2 = a * a + b * b;
-        let n = n2.sqrt();
-        let phi = 1.0 / n - 1.0;
-        let dphi = (a * a / (hs[0] + t) + b * b / (hs[1] + t)) / (n2 * n);
-        let step = phi / dphi;
+        let step = n2 * (1.0 - n2.sqrt()) / (a * a * r0 + b * b * r1);
         if !step.is_finite() {
             break;
         }
@@ -164,7 +176,10 @@ fn disk_boundary_solve(h: &Matrix2<f64>, c: &Vector2<f64>, s: f64) -> Vector2<f6
         } else {
             0.5 * (t + lower)
         };
-        if step.abs() <= 1e-15 * t.abs().max(f64::MIN_POSITIVE) {
+        // φ is close to linear in t − lower (exactly so when one term dominates), so Newton's
+        // error after a step of δ is about δ²/(t − lower): a step below 1e-8 (t − lower)
+        // leaves round-off.
+        if step.abs() <= 1e-8 * (t - lower) {
             break;
         }
     }
@@ -181,13 +196,25 @@ fn disk_boundary_solve(h: &Matrix2<f64>, c: &Vector2<f64>, s: f64) -> Vector2<f6
     }
 }
 
-/// Eigen-decomposition `H = Q diag(h) Qᵀ` of a symmetric 2 × 2 matrix, in closed form
-/// (Jacobi rotation by `θ = ½ atan2(2 h₁₂, h₁₁ − h₂₂)`).
+/// Eigen-decomposition `H = Q diag(h) Qᵀ` of a symmetric 2 × 2 matrix, in closed form: the
+/// Jacobi rotation that zeroes `h₁₂` (Golub & Van Loan, *Matrix Computations*, §8.5.2,
+/// `sym.schur2`), `τ = (h₂₂ − h₁₁)/(2h₁₂)`, `t = sign(τ)/(|τ| + √(1 + τ²))`, `c = 1/√(1 + t²)`,
+/// `s = t c`, without trigonometric functions (this runs in every local solve).
 #[inline]
 fn symmetric_eigen2(h: &Matrix2<f64>) -> (Matrix2<f64>, [f64; 2]) {
     let (a, b, d) = (h[(0, 0)], 0.5 * (h[(0, 1)] + h[(1, 0)]), h[(1, 1)]);
-    let theta = 0.5 * (2.0 * b).atan2(a - d);
-    let (sn, cs) = theta.sin_cos();
+    let (cs, sn) = if b == 0.0 {
+        (1.0, 0.0)
+    } else {
+        let tau = (d - a) / (2.0 * b);
+        let t = if tau.is_finite() {
+            tau.signum() / (tau.abs() + (1.0 + tau * tau).sqrt())
+        } else {
+            0.5 / tau // τ overflowed: t = 1/(2τ) to first order, i.e. 0
+        };
+        let c = 1.0 / (1.0 + t * t).sqrt();
+        (c, -t * c)
+    };
     let q = Matrix2::new(cs, -sn, sn, cs);
     let e0 = a * cs * cs + 2.0 * b * sn * cs + d * sn * sn;
     let e1 = a * sn * sn - 2.0 * b * sn * cs + d * cs * cs;
@@ -203,10 +230,15 @@ mod tests {
             Matrix2::new(1.0, 0.0, 0.0, 4.0),
             Matrix2::new(3.0, -1.0, -1.0, 3.0),
             Matrix2::new(1.0, 0.0, 0.0, 1.0),
+            Matrix2::new(3.0179, -7.96e-4, -7.96e-4, 4.69e-3),
+            Matrix2::new(1.0, 1e-300, 1e-300, 1.0 + 1e-16),
+            Matrix2::new(2.0, 0.0, 0.0, 1.0),
         ] {
             let (q, e) = symmetric_eigen2(&h);
             let back = q * Matrix2::new(e[0], 0.0, 0.0, e[1]) * q.transpose();
             assert!((back - h).norm() < 1e-14 * h.norm(), "{h} vs {back}");
+            let diag = q.transpose() * h * q;
+            assert!(diag[(0, 1)].abs() < 1e-15 * h.norm(), "{diag}");
             assert!((q.transpose() * q - Matrix2::identity()).norm() < 1e-15);
         }
     }

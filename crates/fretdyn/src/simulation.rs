@@ -727,10 +727,16 @@ impl<'m> Simulation<'m> {
         let model = self.model;
         let values = self.contacts.iter().zip(&model.contacts).map(|(s, c)| {
             let local = c.local(&s.x, t);
-            let (radial, angle) = if c.obstacle.is_hole() {
-                (local.norm(), local.y.atan2(local.x))
+            let (radial, direction) = if c.obstacle.is_hole() {
+                let r = local.norm();
+                let unit = if r > 0.0 {
+                    [local.x / r, local.y / r]
+                } else {
+                    [1.0, 0.0]
+                };
+                (r, unit)
             } else {
-                (local.x, 0.0)
+                (local.x, [1.0, 0.0])
             };
             let (slip_speed, friction_power) = if s.closed {
                 let vt = s.tangential_velocity();
@@ -748,7 +754,7 @@ impl<'m> Simulation<'m> {
                 friction_power,
                 penetration: s.frame.penetration,
                 radial,
-                angle,
+                direction,
             }
         });
         self.statistics

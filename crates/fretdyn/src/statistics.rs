@@ -126,8 +126,16 @@ pub struct StepValues {
     /// Radial offset of the point from the hole's centre (holes), or its distance to the
     /// plane / the bars' mid-plane (planes), m.
     pub radial: f64,
-    /// Angle of that offset in the hole's plane, rad (0 for planes).
-    pub angle: f64,
+    /// Direction of that offset in the hole's plane, `(cos θ, sin θ)` (`(1, 0)` for planes
+    /// and at the centre): the angle `θ` is only formed (`atan2`) where it is reported.
+    pub direction: [f64; 2],
+}
+
+impl StepValues {
+    /// The angle `θ` of [`StepValues::direction`], degrees in (−180, 180].
+    fn angle_deg(&self) -> f64 {
+        self.direction[1].atan2(self.direction[0]).to_degrees()
+    }
 }
 
 /// A finished impact (per-impact table).
@@ -210,7 +218,7 @@ impl ImpactTracker {
                         impulse: 0.0,
                         rebound_speed: 0.0,
                         rebounds: 0,
-                        angle_deg: v.angle.to_degrees(),
+                        angle_deg: v.angle_deg(),
                     });
                 }
             }
@@ -220,7 +228,7 @@ impl ImpactTracker {
                 if v.normal > imp.peak_force {
                     imp.peak_force = v.normal;
                     imp.peak_time = v.t;
-                    imp.angle_deg = v.angle.to_degrees();
+                    imp.angle_deg = v.angle_deg();
                 }
             }
         } else if self.active {
@@ -329,8 +337,8 @@ impl ContactAccumulator {
             self.tangential_max = self.tangential_max.max(v.tangential);
             self.wear_work += v.friction_power * dt;
             self.normal_wear_work += v.normal * v.slip_speed * dt;
-            self.angle_cos += v.angle.cos();
-            self.angle_sin += v.angle.sin();
+            self.angle_cos += v.direction[0];
+            self.angle_sin += v.direction[1];
         }
     }
 
