@@ -1,6 +1,6 @@
 //! Criterion benchmarks of the time-step loop: V1 (3 modes, 1 contact) and the synthetic
 //! rattling tube (50 modes, 8 contacts), each with the three tangential methods.
-//! Run: cargo bench -p fretdyn --bench step
+//! Run: cargo bench -p fretdyn-bench --bench step
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use fretdyn::benchmark::rattling_tube;
