@@ -21,7 +21,23 @@ CLEARANCES = [1e-4, 1.5e-4, 2e-4, 3e-4, 4e-4]
 METHODS = ["gauss_seidel", "active_set", "penalty"]
 
 
+def pyplot():
+    """matplotlib's pyplot (Agg backend), checked before any run is done."""
+    try:
+        import matplotlib
+    except ImportError:
+        sys.exit(
+            "gap_study.py draws its plot with matplotlib, which is not installed in this "
+            f"Python ({sys.executable}): pip install matplotlib"
+        )
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
 def main():
+    plt = pyplot()
     out = Path.cwd()
     study = out / "gap_study.toml"
     base = (HERE.parent / "tube_multispan.toml").as_posix()
@@ -47,11 +63,6 @@ def main():
     total = sum(t[f"{c}.wear_work_rate"] for c in contacts)
     x = t["contacts.*.obstacle.clearance"]
     method = np.array(t["tangential.method"])
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for m in METHODS:

@@ -5,7 +5,8 @@
 //! - `contact_displacement.png`: the point's displacement at each contact against time (radial
 //!   offset from the hole's centre, or distance to the plane);
 //! - `orbits.png`: the orbit of the tube centre inside each hole, with the hole's outline;
-//! - `peak_forces.png`: histogram of the impacts' peak forces, per contact;
+//! - `peak_forces.png`: histogram of the impacts' peak forces (5 bins a decade, on one
+//!   logarithmic force axis for every contact), per contact;
 //! - `wear.png`: wear work rate per contact (friction power and `R_N|v_T|` definitions).
 
 use std::path::{Path, PathBuf};
@@ -15,7 +16,7 @@ use ndarray_npy::{NpzReader, ReadNpyExt};
 use serde_json::Value;
 
 use crate::Failure;
-use crate::plot::{Bar, Series, bar_panels, panels_plot, xy_panels};
+use crate::plot::{Bar, Bin, Series, bar_panels, histogram_panels, panels_plot, xy_panels};
 
 /// The time histories the plots need.
 struct Histories {
@@ -185,7 +186,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
         &path,
         &format!("{title} — displacement at the contacts"),
         "t (s)",
-        "m",
+        "displacement (m)",
         &panels,
     )
     .map_err(fail)?;
@@ -197,14 +198,8 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
         let orbits: Vec<(Vec<f64>, Vec<f64>)> = holes
             .iter()
             .map(|&k| {
-                let mm = |i: usize| -> Vec<f64> {
-                    h.position
-                        .slice(ndarray::s![.., k, i])
-                        .iter()
-                        .map(|v| 1e3 * v)
-                        .collect()
-                };
-                (mm(0), mm(1))
+                let coord = |i: usize| h.position.slice(ndarray::s![.., k, i]).to_vec();
+                (coord(0), coord(1))
             })
             .collect();
         let outlines: Vec<(Vec<f64>, Vec<f64>)> = holes
@@ -215,9 +210,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
                     .cloned()
                     .unwrap_or_default();
                 let coord = |i: usize| -> Vec<f64> {
-                    pts.iter()
-                        .map(|p| 1e3 * p[i].as_f64().unwrap_or(0.0))
-                        .collect()
+                    pts.iter().map(|p| p[i].as_f64().unwrap_or(0.0)).collect()
                 };
                 (coord(0), coord(1))
             })
@@ -247,8 +240,8 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
         xy_panels(
             &path,
             &format!("{title} — orbit of the tube centre in the holes"),
-            "e1 (mm)",
-            "e2 (mm)",
+            "e1 (m)",
+            "e2 (m)",
             &panels,
         )
         .map_err(fail)?;
@@ -258,7 +251,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
     // histograms of the peak forces, 5 bins per decade
     let peaks = read_peaks(dir, nc);
     if peaks.iter().any(|p| !p.is_empty()) {
-        let panels: Vec<(String, Vec<Bar>)> = (0..nc)
+        let panels: Vec<(String, Vec<Bin>)> = (0..nc)
             .filter(|&k| !peaks[k].is_empty())
             .map(|k| {
                 (
@@ -268,9 +261,10 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
             })
             .collect();
         let path = dir.join("peak_forces.png");
-        bar_panels(
+        histogram_panels(
             &path,
             &format!("{title} — peak force of the impacts"),
+            "peak force R_N (N)",
             "impacts",
             &panels,
         )
@@ -282,7 +276,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
     let rate = |k: usize, key: &str| stats[k][key].as_f64().unwrap_or(0.0);
     let panels = vec![
         (
-            "friction power (1/T)∫|R_T·v_T| dt (W)".to_string(),
+            "friction power (1/T)∫|R_T·v_T| dt".to_string(),
             (0..nc)
                 .map(|k| Bar {
                     label: names[k].clone(),
@@ -291,7 +285,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
                 .collect(),
         ),
         (
-            "normal-force definition (1/T)∫R_N|v_T| dt (W)".to_string(),
+            "normal-force definition (1/T)∫R_N|v_T| dt".to_string(),
             (0..nc)
                 .map(|k| Bar {
                     label: names[k].clone(),
@@ -304,7 +298,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
     bar_panels(
         &path,
         &format!("{title} — wear work rate per contact"),
-        "W",
+        "wear work rate (W)",
         &panels,
     )
     .map_err(fail)?;
@@ -312,12 +306,14 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
     Ok(written)
 }
 
-/// Logarithmic histogram, `per_decade` bins per decade, labelled by their lower edge.
-fn histogram(values: &[f64], per_decade: usize) -> Vec<Bar> {
+/// Logarithmic histogram, `per_decade` bins per decade (edges 10^(i/per_decade)), from the
+/// first to the last bin holding a value.
+fn histogram(values: &[f64], per_decade: usize) -> Vec<Bin> {
+    let per = per_decade as f64;
     let logs: Vec<f64> = values
         .iter()
         .filter(|v| **v > 0.0 && v.is_finite())
-        .map(|v| v.log10() * per_decade as f64)
+        .map(|v| v.log10() * per)
         .collect();
     if logs.is_empty() {
         return Vec::new();
@@ -335,12 +331,13 @@ fn histogram(values: &[f64], per_decade: usize) -> Vec<Bar> {
     counts
         .iter()
         .enumerate()
-        .map(|(i, &c)| Bar {
-            label: format!(
-                "{:.3e} N",
-                10f64.powf((lo + i as i64) as f64 / per_decade as f64)
-            ),
-            value: c as f64,
+        .map(|(i, &count)| {
+            let edge = |j: i64| 10f64.powf(j as f64 / per);
+            Bin {
+                lo: edge(lo + i as i64),
+                hi: edge(lo + i as i64 + 1),
+                count,
+            }
         })
         .collect()
 }

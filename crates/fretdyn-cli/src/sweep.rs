@@ -118,9 +118,9 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
         for r in &sorted {
             let label = others
                 .iter()
-                .map(|&i| format!("{}={}", header[i], r[i]))
+                .map(|&i| parameter_value(header[i], r[i]))
                 .collect::<Vec<_>>()
-                .join(" ");
+                .join(", ");
             let (Ok(xv), Ok(yv)) = (r[xi].parse::<f64>(), r[*col].parse::<f64>()) else {
                 continue;
             };
@@ -134,6 +134,7 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
         }
         data.push((contact.clone(), lines));
     }
+    let y_label = statistic_label(statistic);
     let panels: Vec<(String, Vec<Series>)> = data
         .iter()
         .map(|(c, lines)| {
@@ -143,7 +144,7 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
                     .iter()
                     .map(|(label, x, y)| Series {
                         label: if label.is_empty() {
-                            statistic.to_string()
+                            y_label.clone()
                         } else {
                             label.clone()
                         },
@@ -154,12 +155,181 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
             )
         })
         .collect();
+    let (x_name, _) = parameter_name(x);
+    let (y_name, _) = statistic_name(statistic);
     panels_plot(
         path,
-        &format!("{statistic} against {x}"),
-        x,
-        statistic,
+        &format!("{} against {x_name}", capitalised(&y_name)),
+        &parameter_label(x),
+        &y_label,
         &panels,
     )
     .map_err(Failure::failed)
+}
+
+fn capitalised(s: &str) -> String {
+    let mut chars = s.chars();
+    chars
+        .next()
+        .map(|c| c.to_uppercase().chain(chars).collect())
+        .unwrap_or_default()
+}
+
+/// Axis label `quantity (unit)` from a name and a unit (none: the name alone).
+fn with_unit(name: String, unit: &str) -> String {
+    if unit.is_empty() {
+        name
+    } else {
+        format!("{name} ({unit})")
+    }
+}
+
+/// A readable name of a parameter key of a study (a dotted path in the case: a number picks
+/// an array element, `*` every element), and its unit in base SI ("" when dimensionless or not
+/// a number): `contacts.*.obstacle.clearance` → (`clearance, every contact`, `m`),
+/// `contacts[0].normal.stiffness` → (`normal stiffness, contact 0`, `N/m`).
+fn parameter_name(key: &str) -> (String, &'static str) {
+    let normalised = key.replace('[', ".").replace(']', "");
+    let segments: Vec<&str> = normalised.split('.').filter(|s| !s.is_empty()).collect();
+    let is_index = |s: &str| s == "*" || s.parse::<usize>().is_ok();
+    // where the parameter applies: the innermost array element
+    let place = segments.windows(2).rev().find_map(|w| {
+        is_index(w[1]).then(|| {
+            let singular = w[0].strip_suffix('s').unwrap_or(w[0]).replace('_', " ");
+            if w[1] == "*" {
+                format!("every {singular}")
+            } else {
+                format!("{singular} {}", w[1])
+            }
+        })
+    });
+    let names: Vec<&str> = segments.iter().copied().filter(|s| !is_index(s)).collect();
+    let last = names.last().copied().unwrap_or(key);
+    let parent = names.len().checked_sub(2).map(|i| names[i]).unwrap_or("");
+    let unit = match last {
+        "clearance" | "radius" | "gap" | "mesh_size" | "outer_diameter" | "wall_thickness"
+        | "leg_length" | "correlation_length" | "x" => "m",
+        "dt" | "duration" | "t_start" | "t_end" | "block" | "rest_duration" => "s",
+        "stiffness" | "force_per_length" => "N/m",
+        "damping" if parent != "structure" => "N·s/m",
+        "young_modulus" => "Pa",
+        "density" | "inner_fluid_density" | "outer_fluid_density" => "kg/m³",
+        "f_max" | "max_frequency_hz" => "Hz",
+        "force" => "N",
+        "acceleration" => "m/s²",
+        _ => "",
+    };
+    let word = match last {
+        "mu" => "friction coefficient".to_string(),
+        "mu_static" => "static friction coefficient".to_string(),
+        "mu_dynamic" => "dynamic friction coefficient".to_string(),
+        "dt" => "time step".to_string(),
+        "f_max" => "maximum frequency".to_string(),
+        other => other.replace('_', " "),
+    };
+    // a generic word takes its section's name: normal stiffness, tangential method
+    let qualified = match parent {
+        "normal" | "penalty" | "tangential" | "gauss_seidel" | "active_set" => {
+            format!("{} {word}", parent.replace('_', " "))
+        }
+        _ => word,
+    };
+    let name = match place {
+        Some(place) => format!("{qualified}, {place}"),
+        None => qualified,
+    };
+    (name, unit)
+}
+
+/// Axis label of a parameter key: its readable name and unit.
+fn parameter_label(key: &str) -> String {
+    let (name, unit) = parameter_name(key);
+    with_unit(name, unit)
+}
+
+/// `name = value unit` for the legend (the name without where it applies).
+fn parameter_value(key: &str, value: &str) -> String {
+    let (name, unit) = parameter_name(key);
+    let name = name.split(", ").next().unwrap_or(&name).to_string();
+    if unit.is_empty() || value.parse::<f64>().is_err() {
+        format!("{name} = {value}")
+    } else {
+        format!("{name} = {value} {unit}")
+    }
+}
+
+/// Readable name and unit of a statistic of the study table
+/// ([`fretdyn::study::TABLE_STATISTICS`]); another: its key with spaces, no unit.
+fn statistic_name(statistic: &str) -> (String, &'static str) {
+    match known_statistic(statistic) {
+        Some((name, unit)) => (name.to_string(), unit),
+        None => (statistic.replace('_', " "), ""),
+    }
+}
+
+fn known_statistic(statistic: &str) -> Option<(&'static str, &'static str)> {
+    Some(match statistic {
+        "impacts_per_second" => ("impact rate", "1/s"),
+        "contact_time_fraction" => ("fraction of the time in contact", ""),
+        "stick_time_fraction" => ("fraction of the time sticking", ""),
+        "slip_time_fraction" => ("fraction of the time slipping", ""),
+        "normal_force_mean" => ("mean normal force", "N"),
+        "normal_force_rms" => ("RMS normal force", "N"),
+        "normal_force_max" => ("maximum normal force", "N"),
+        "tangential_force_rms" => ("RMS tangential force", "N"),
+        "wear_work_rate" => ("wear work rate", "W"),
+        "normal_wear_work_rate" => ("wear work rate, R_N|v_T| definition", "W"),
+        _ => return None,
+    })
+}
+
+/// Axis label of a statistic: its readable name and unit.
+fn statistic_label(statistic: &str) -> String {
+    let (name, unit) = statistic_name(statistic);
+    with_unit(name, unit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn study_axes_are_readable_with_their_unit() {
+        assert_eq!(
+            parameter_label("contacts.*.obstacle.clearance"),
+            "clearance, every contact (m)"
+        );
+        assert_eq!(
+            parameter_label("contacts[0].obstacle.clearance"),
+            "clearance, contact 0 (m)"
+        );
+        assert_eq!(
+            parameter_label("contacts.2.normal.stiffness"),
+            "normal stiffness, contact 2 (N/m)"
+        );
+        assert_eq!(
+            parameter_label("contacts.*.friction.mu"),
+            "friction coefficient, every contact"
+        );
+        assert_eq!(parameter_label("time.duration"), "duration (s)");
+        assert_eq!(parameter_label("time.dt"), "time step (s)");
+        assert_eq!(parameter_label("tangential.method"), "tangential method");
+        assert_eq!(
+            parameter_value("tangential.method", "gauss_seidel"),
+            "tangential method = gauss_seidel"
+        );
+        assert_eq!(
+            parameter_value("contacts.*.obstacle.clearance", "0.0002"),
+            "clearance = 0.0002 m"
+        );
+        assert_eq!(statistic_label("wear_work_rate"), "wear work rate (W)");
+        assert_eq!(
+            statistic_label("normal_force_max"),
+            "maximum normal force (N)"
+        );
+        // every statistic of the table has a readable name
+        for s in fretdyn::study::TABLE_STATISTICS {
+            assert!(known_statistic(s).is_some(), "{s}");
+        }
+    }
 }

@@ -11,6 +11,9 @@ use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+mod dict_case;
+use dict_case::Document;
+
 pyo3::create_exception!(
     _native,
     FretdynError,
@@ -106,17 +109,31 @@ fn case_from_toml(text: &str, base_dir: PathBuf) -> PyResult<Case> {
         .map_err(err)
 }
 
-/// A case from JSON text with the structure of a case file (how Python dicts come in).
+/// A case from JSON text with the structure of a case file (how Python dicts come in). It is
+/// read by the case file's parser, through TOML text whose lines are mapped back to the keys
+/// of the dict: errors name the key path (`time.dt`, `contacts[0].normal.stiffness`).
 #[pyfunction]
 #[pyo3(signature = (json, base_dir = PathBuf::from(".")))]
 fn case_from_json(json: &str, base_dir: PathBuf) -> PyResult<Case> {
     let value: serde_json::Value = serde_json::from_str(json)
         .map_err(|e| FretdynError::new_err(format!("the case is not valid JSON: {e}")))?;
-    let toml_value = toml::Value::try_from(value)
-        .map_err(|e| FretdynError::new_err(format!("the case cannot be written as TOML: {e}")))?;
-    let text = toml::to_string(&toml_value)
-        .map_err(|e| FretdynError::new_err(format!("the case cannot be written as TOML: {e}")))?;
-    case_from_toml(&text, base_dir)
+    let serde_json::Value::Object(root) = value else {
+        return Err(FretdynError::new_err(
+            "a case is a dict with the keys of a case file (time, structure, contacts, …)",
+        ));
+    };
+    let doc = Document::from_json(&root).map_err(FretdynError::new_err)?;
+    fretdyn::case::Case::from_toml_str(&doc.text, &base_dir)
+        .map(|inner| Case { inner })
+        .map_err(|e| match e {
+            fretdyn::Error::Parse { line, message, .. } => {
+                FretdynError::new_err(match doc.path_at(line, &message) {
+                    Some(path) => format!("{path}: {message}"),
+                    None => message,
+                })
+            }
+            other => err(other),
+        })
 }
 
 /// Runs a case with the GIL released; Ctrl-C stops it (KeyboardInterrupt). Returns a dict of

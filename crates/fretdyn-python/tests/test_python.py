@@ -59,10 +59,10 @@ def test_errors_are_exceptions_with_the_cli_message(tmp_path):
         fretdyn.modal_structure([1.0, 2.0], {"a": np.zeros((3, 3))})
 
 
-def test_a_case_from_a_dict_and_numpy_arrays_equals_the_file():
-    file = fretdyn.Case.from_file(EXAMPLES / "v1a_modal_inline.toml")
+def v1a_dict():
+    """V1a (examples/v1a_modal_inline.toml) as a dict with numpy arrays."""
     a = np.radians(20.0)
-    case = {
+    return {
         "title": "V1a from Python",
         "time": {"dt": 1e-6, "duration": 4e-3},
         "structure": fretdyn.modal_structure(
@@ -78,9 +78,86 @@ def test_a_case_from_a_dict_and_numpy_arrays_equals_the_file():
         }],
         "tangential": {"method": "gauss_seidel"},
     }
-    r1, r2 = fretdyn.run(file), fretdyn.run(fretdyn.Case.from_dict(case))
+
+
+def test_a_case_from_a_dict_and_numpy_arrays_equals_the_file():
+    file = fretdyn.Case.from_file(EXAMPLES / "v1a_modal_inline.toml")
+    r1, r2 = fretdyn.run(file), fretdyn.run(fretdyn.Case.from_dict(v1a_dict()))
     for k in KEYS:
         assert np.allclose(r1[k], r2[k], rtol=1e-12, atol=1e-15), k
+
+
+def test_errors_of_a_dict_name_its_key_path():
+    def error(change):
+        case = v1a_dict()
+        change(case)
+        with pytest.raises(fretdyn.FretdynError) as e:
+            fretdyn.Case.from_dict(case)
+        message = str(e.value)
+        # a position in the TOML text the dict was written to means nothing to the user
+        assert "line" not in message and "column" not in message, message
+        return message
+
+    contact = lambda c: c["contacts"][0]
+    cases = [
+        # (what is broken, the key path the message must start with)
+        (lambda c: c["time"].update(dt="1e-6"), "time.dt: "),
+        (lambda c: contact(c)["normal"].update(stiffness="stiff"), "contacts[0].normal.stiffness: "),
+        (lambda c: contact(c)["normal"].update(stiffnes=1e6), "contacts[0].normal.stiffnes: "),
+        (lambda c: contact(c)["normal"].pop("stiffness"), "contacts[0].normal.stiffness: "),
+        (lambda c: c["time"].pop("duration"), "time.duration: "),
+        (lambda c: c.update(tangential={"method": "coulomb"}), "tangential.method: "),
+        # a tagged table (the obstacle) is read whole: still the key
+        (lambda c: contact(c)["obstacle"].update(gap="none"), "contacts[0].obstacle.gap: "),
+        (lambda c: c.update(title=None), "title: "),
+        # after parsing: the validation's own message, unchanged
+        (lambda c: contact(c)["normal"].update(stiffness=-1.0), "contacts[0].normal.stiffness: "),
+    ]
+    for change, path in cases:
+        message = error(change)
+        assert message.startswith(path), (path, message)
+    # the second contact of two
+    def second(c):
+        c["contacts"].append(dict(contact(c), name="other", normal={"stiffness": "x", "damping": 0.0}))
+
+    assert error(second).startswith("contacts[1].normal.stiffness: ")
+
+
+def test_run_takes_the_path_of_a_case_file(tmp_path):
+    path = EXAMPLES / "v1a_oblique_impact.toml"
+    reference = fretdyn.run(fretdyn.Case.from_file(path))
+    for given in (str(path), path):
+        r = fretdyn.run(given)
+        for k in KEYS:
+            assert same_bits(r[k], reference[k]), (type(given), k)
+    with pytest.raises(fretdyn.FretdynError, match="missing.toml"):
+        fretdyn.run(tmp_path / "missing.toml")
+    for wrong in (42, {"time": {}}, None):
+        with pytest.raises(TypeError, match="Case.from_dict.*path of a case file"):
+            fretdyn.run(wrong)
+    with pytest.raises(TypeError, match="Case.from_toml"):
+        fretdyn.run(path.read_text())
+
+
+def test_gap_study_checks_for_matplotlib_before_the_sweep(tmp_path):
+    import sys
+
+    # a matplotlib that cannot be imported, whether or not this Python has one
+    shadow = tmp_path / "shadow" / "matplotlib"
+    shadow.mkdir(parents=True)
+    (shadow / "__init__.py").write_text("raise ImportError('No module named matplotlib')\n")
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(shadow.parent), env.get("PYTHONPATH", "")])
+    work = tmp_path / "work"
+    work.mkdir()
+    p = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "python" / "gap_study.py")],
+        cwd=work, env=env, capture_output=True, text=True, timeout=120,
+    )
+    assert p.returncode != 0
+    assert "pip install matplotlib" in p.stderr, p.stderr
+    # no run was done
+    assert not (work / "gap_study.csv").exists()
 
 
 def study(tmp_path):

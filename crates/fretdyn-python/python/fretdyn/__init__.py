@@ -4,6 +4,7 @@ Coulomb friction (explicit central differences; penalty, Active Set or projected
     import fretdyn
     case = fretdyn.Case.from_file("examples/v1a_oblique_impact.toml")
     r = fretdyn.run(case)            # numpy arrays, GIL released, Ctrl-C honoured
+    r = fretdyn.run("examples/v1a_oblique_impact.toml")   # the same, from the path
     r["contact_normal_force"][:, 0], r["summary"]["contacts"][0]["wear_work_rate"]
 
 Cases come from a TOML file, TOML text, or a Python dict with the structure of a case file
@@ -61,7 +62,8 @@ class Case:
 
     @classmethod
     def from_dict(cls, case: Mapping[str, Any], base_dir: PathLike = ".") -> "Case":
-        """A case from a dict with the keys of a case file (numpy arrays allowed)."""
+        """A case from a dict with the keys of a case file (numpy arrays allowed). Errors name
+        the key path in the dict (`time.dt`, `contacts[0].normal.stiffness`)."""
         return cls(_native.case_from_json(json.dumps(_plain(case)), os.fspath(base_dir)))
 
     title = property(lambda self: self._native.title, doc="Title of the case.")
@@ -105,10 +107,23 @@ def modal_structure(
     return structure
 
 
-def run(case: Case) -> dict:
-    """Runs a case (the GIL is released; Ctrl-C raises KeyboardInterrupt). Returns the arrays
-    of `results.npz` as numpy arrays and `summary`, the content of `summary.json` as a dict.
-    A diverged run returns what it computed; its `summary["termination"]` says where."""
+def run(case: Union[Case, PathLike]) -> dict:
+    """Runs a case, or the case file at a path (str or os.PathLike), like `fretdyn run` (the
+    GIL is released; Ctrl-C raises KeyboardInterrupt). Returns the arrays of `results.npz` as
+    numpy arrays and `summary`, the content of `summary.json` as a dict. A diverged run
+    returns what it computed; its `summary["termination"]` says where."""
+    if isinstance(case, (str, os.PathLike)):
+        if isinstance(case, str) and "\n" in case:
+            raise TypeError(
+                "fretdyn.run: a str is the path of a case file; for TOML text use "
+                "fretdyn.run(fretdyn.Case.from_toml(text))"
+            )
+        case = Case.from_file(case)
+    elif not isinstance(case, Case):
+        raise TypeError(
+            "fretdyn.run takes a Case (Case.from_file, Case.from_toml, Case.from_dict) or the "
+            f"path of a case file (str or os.PathLike), not {type(case).__name__}"
+        )
     out = _native.run(case._native)
     out["summary"] = json.loads(out.pop("summary_json"))
     return out
