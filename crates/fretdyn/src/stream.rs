@@ -160,13 +160,6 @@ pub fn resume(
             ),
         ));
     }
-    // the results.npz of a stop is packed again at the end; until then none is a complete run
-    match std::fs::remove_file(dir.join(RESULTS_FILE)) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            return Err(Error::io(dir.join(RESULTS_FILE), e));
-        }
-        _ => {}
-    }
     let sim = Simulation::resume(model, settings, checkpoint.snapshot, stream.chunk_samples)?;
     let files = Files::reopen(
         dir,
@@ -175,6 +168,14 @@ pub fn resume(
         checkpoint.impacts_bytes,
         checkpoint.blocks_bytes,
     )?;
+    // the results.npz of a stop is packed again at the end; until then, a results.npz beside
+    // the last checkpoint is that of a complete run
+    match std::fs::remove_file(dir.join(RESULTS_FILE)) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(Error::io(dir.join(RESULTS_FILE), e));
+        }
+        _ => {}
+    }
     drive(sim, files, settings, stream, fingerprint, observer)
 }
 
