@@ -11,6 +11,7 @@ use fretdyn::verification::V1;
 use std::path::Path;
 
 use crate::Failure;
+use crate::out::outln;
 use crate::plot::{Series, panels_plot};
 
 /// Entry point of `fretdyn bench`.
@@ -27,20 +28,20 @@ fn methods() -> [TangentialMethod; 3] {
 
 pub fn main(steps: u64, repeat: usize, modes: usize, contacts: usize) -> Result<(), Failure> {
     let methods = methods();
-    println!(
+    outln!(
         "machine: {}, {} logical CPUs",
         cpu_model(),
         std::thread::available_parallelism().map_or(1, |n| n.get())
-    );
-    println!(
+    )?;
+    outln!(
         "fretdyn {} (release build: {})",
         env!("CARGO_PKG_VERSION"),
         !cfg!(debug_assertions)
-    );
-    println!(
+    )?;
+    outln!(
         "| case | method | modes | contacts | steps | best wall time (s) | steps/s | closed-contact steps |"
-    );
-    println!("|---|---|---|---|---|---|---|---|");
+    )?;
+    outln!("|---|---|---|---|---|---|---|---|")?;
     for method in methods {
         let v1 = V1::reference(20.0);
         let mut settings = v1.settings(method, StickVelocity::HalfStep);
@@ -67,9 +68,9 @@ const SCALING_CONTACTS: [usize; 5] = [1, 5, 10, 25, 50];
 /// cost of the tangential problem grows with those, not with the contacts declared).
 pub fn scaling(dir: &Path, steps: u64) -> Result<(), Failure> {
     std::fs::create_dir_all(dir).map_err(|e| Failure::failed(format!("{}: {e}", dir.display())))?;
-    println!("machine: {}, {steps} steps per run, best of 2", cpu_model());
-    println!("| method | modes | contacts | mean closed | µs/step | steps/s |");
-    println!("|---|---|---|---|---|---|");
+    outln!("machine: {}, {steps} steps per run, best of 2", cpu_model())?;
+    outln!("| method | modes | contacts | mean closed | µs/step | steps/s |")?;
+    outln!("|---|---|---|---|---|---|")?;
     let mut csv = String::from("method,modes,contacts,mean_closed,us_per_step,steps_per_s\n");
     // per method, per contact count: (modes, µs/step)
     let mut curves: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
@@ -92,12 +93,12 @@ pub fn scaling(dir: &Path, steps: u64) -> Result<(), Failure> {
                         .sum::<f64>();
                 }
                 let us = 1e6 * best / steps as f64;
-                println!(
+                outln!(
                     "| {} | {} | {contacts} | {closed:.2} | {us:.3} | {:.3e} |",
                     method.name(),
                     case.model.basis.modes(),
                     1e6 / us
-                );
+                )?;
                 csv.push_str(&format!(
                     "{},{},{contacts},{closed:.4},{us:.5},{:.1}\n",
                     method.name(),
@@ -137,7 +138,7 @@ pub fn scaling(dir: &Path, steps: u64) -> Result<(), Failure> {
         &panels,
     )
     .map_err(Failure::failed)?;
-    println!("wrote {} and {}", csv_path.display(), png.display());
+    outln!("wrote {} and {}", csv_path.display(), png.display())?;
     Ok(())
 }
 
@@ -151,7 +152,7 @@ fn bench_case(case: &Case, repeat: usize) -> Result<(), Failure> {
         closed = r.solver.lagrange_steps;
     }
     let s = &case.settings;
-    println!(
+    outln!(
         "| {} | {} | {} | {} | {} | {:.4} | {:.3e} | {} |",
         case.title,
         s.method.name(),
@@ -165,7 +166,7 @@ fn bench_case(case: &Case, repeat: usize) -> Result<(), Failure> {
         } else {
             "—".into()
         }
-    );
+    )?;
     Ok(())
 }
 

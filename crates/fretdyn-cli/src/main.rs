@@ -2,6 +2,7 @@
 
 mod bench;
 mod modes;
+mod out;
 mod plot;
 mod progress;
 mod results_plots;
@@ -12,7 +13,9 @@ mod verify;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
+
+use crate::out::{errln, outln};
 
 /// Nonlinear vibration of structures on a modal basis rattling against obstacles with Coulomb
 /// friction (explicit central differences; penalty, Active Set or projected Gauss–Seidel).
@@ -26,19 +29,21 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Run a case file; without one, run the built-in demo (V1a with the three methods).
-    /// Results are streamed to the output folder; Ctrl-C stops after a checkpoint.
+    /// Results are streamed to the output folder; Ctrl-C or SIGTERM (timeout, a batch
+    /// scheduler, docker stop) stops after a checkpoint.
     Run {
         /// Case file (TOML). See examples/ for the reference of every key.
+        #[arg(value_parser = path)]
         case: Option<PathBuf>,
-        /// Continue the interrupted (Ctrl-C, killed) run in this folder from its last
-        /// checkpoint; the results are those of an uninterrupted run.
-        #[arg(long, value_name = "DIR")]
+        /// Continue the interrupted (Ctrl-C, SIGTERM, killed, out of disk) run in this folder
+        /// from its last checkpoint; the results are those of an uninterrupted run.
+        #[arg(long, value_name = "DIR", value_parser = path)]
         resume: Option<PathBuf>,
         /// Wall-clock seconds between checkpoints.
         #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
         checkpoint_every: f64,
         /// Output folder [default: fretdyn_results/<case name>].
-        #[arg(short, long)]
+        #[arg(short, long, value_parser = path)]
         output: Option<PathBuf>,
         /// No progress bar and no report on stdout.
         #[arg(short, long)]
@@ -52,9 +57,10 @@ enum Command {
     /// crash, the finished runs are skipped.
     Sweep {
         /// Study file (TOML), see examples/study_clearance.toml.
+        #[arg(value_parser = path)]
         study: PathBuf,
         /// Output folder [default: fretdyn_results/<study name>].
-        #[arg(short, long)]
+        #[arg(short, long, value_parser = path)]
         output: Option<PathBuf>,
         /// Runs at a time [default: one per core].
         #[arg(short, long, default_value_t = 0)]
@@ -67,13 +73,14 @@ enum Command {
     /// peak-force histograms, wear work rates).
     Plot {
         /// Folder written by `fretdyn run`.
+        #[arg(value_parser = path)]
         dir: PathBuf,
     },
     /// Run V1a, V1b, V1c (THEORY §6) with every method, compare with the analytic solution,
     /// write the figures; exit code 1 if a check fails.
     Verify {
         /// Output folder for figures and verification.json.
-        #[arg(short, long, default_value = "fretdyn_results/verify")]
+        #[arg(short, long, default_value = "fretdyn_results/verify", value_parser = path)]
         output: PathBuf,
         /// Print only failures and the final line.
         #[arg(short, long)]
@@ -83,9 +90,10 @@ enum Command {
     /// a picture of its first mode shapes.
     Modes {
         /// Case file (TOML).
+        #[arg(value_parser = path)]
         case: PathBuf,
         /// Output folder [default: fretdyn_results/<case name>_modes].
-        #[arg(short, long)]
+        #[arg(short, long, value_parser = path)]
         output: Option<PathBuf>,
         /// Mode shapes drawn.
         #[arg(long, default_value_t = 4)]
@@ -107,7 +115,7 @@ enum Command {
         contacts: usize,
         /// Instead: the cost of a step over 10–200 modes × 1–50 contacts, per method, as a
         /// table, `scaling.csv` and `scaling.png` in this folder.
-        #[arg(long, value_name = "DIR")]
+        #[arg(long, value_name = "DIR", value_parser = path)]
         scaling: Option<PathBuf>,
     },
 }
@@ -117,8 +125,49 @@ pub const EXIT_INPUT: u8 = 2;
 /// Exit code of a run that failed (diverged, verification check failed).
 pub const EXIT_FAILED: u8 = 1;
 
+/// A file or folder argument: anything but an empty string.
+fn path(value: &str) -> Result<PathBuf, String> {
+    if value.is_empty() {
+        Err("an empty path: give a file or folder name".into())
+    } else {
+        Ok(PathBuf::from(value))
+    }
+}
+
+/// A command-line error in one line with a hint to the help (exit code 2); the help and the
+/// version as clap prints them.
+fn command_line_error(e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    if matches!(
+        e.kind(),
+        ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        let _ = e.print();
+        return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
+    }
+    let text = e.render().to_string();
+    let first = text
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .trim_start_matches("error: ")
+        .trim();
+    // the help of the subcommand given, if one was
+    let command = std::env::args()
+        .skip(1)
+        .find(|a| Cli::command().find_subcommand(a).is_some())
+        .map_or_else(|| "fretdyn".to_string(), |sub| format!("fretdyn {sub}"));
+    errln!("error: {first} (see '{command} --help')");
+    ExitCode::from(EXIT_INPUT)
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return command_line_error(e),
+    };
     let outcome = match cli.command {
         Command::Run {
             case,
@@ -128,8 +177,8 @@ fn main() -> ExitCode {
             quiet,
             no_plots,
         } => {
-            // Ctrl-C: stop at the next progress report, after a checkpoint (a second Ctrl-C
-            // while stopping is ignored: the files are being closed)
+            // Ctrl-C, SIGTERM, SIGHUP: stop at the next progress report, after a checkpoint (a
+            // second signal while stopping is ignored: the files are being closed)
             let _ = ctrlc::set_handler(|| {
                 run::INTERRUPTED.store(true, std::sync::atomic::Ordering::Relaxed)
             });
@@ -153,10 +202,10 @@ fn main() -> ExitCode {
             jobs,
             quiet,
         } => sweep::main(&study, output, jobs, quiet),
-        Command::Plot { dir } => results_plots::plot_run(&dir).map(|files| {
-            for f in files {
-                println!("wrote {}", f.display());
-            }
+        Command::Plot { dir } => results_plots::plot_run(&dir).and_then(|files| {
+            files
+                .iter()
+                .try_for_each(|f| outln!("wrote {}", f.display()))
         }),
         Command::Verify { output, quiet } => verify::main(&output, quiet),
         Command::Modes {
@@ -178,7 +227,7 @@ fn main() -> ExitCode {
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(failure) => {
-            eprintln!("error: {}", failure.message);
+            errln!("error: {}", failure.message);
             ExitCode::from(failure.code)
         }
     }

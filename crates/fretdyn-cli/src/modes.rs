@@ -7,6 +7,7 @@ use fretdyn::beam::Dof;
 use fretdyn::case::{Case, TubeModel};
 
 use crate::Failure;
+use crate::out::outln;
 use crate::plot::{Series, panels_plot};
 
 /// Entry point of `fretdyn modes`.
@@ -23,36 +24,36 @@ pub fn main(path: &Path, output: Option<PathBuf>, shown: usize) -> Result<(), Fa
         Failure::failed(format!("{}: cannot create the folder: {e}", dir.display()))
     })?;
     let basis = &case.model.basis;
-    println!("{}: {} modes", case.title, basis.modes());
-    println!("{:>5} {:>14} {:>10}", "mode", "frequency (Hz)", "damping");
+    outln!("{}: {} modes", case.title, basis.modes())?;
+    outln!("{:>5} {:>14} {:>10}", "mode", "frequency (Hz)", "damping")?;
     for (i, (w, xi)) in basis.omega.iter().zip(&basis.damping_ratio).enumerate() {
-        println!(
+        outln!(
             "{:>5} {:>14.6} {:>10.4}",
             i + 1,
             w / std::f64::consts::TAU,
             xi
-        );
+        )?;
     }
     if let Some(tube) = &case.tube {
         let a = &tube.basis.assembled;
-        println!(
+        outln!(
             "finite elements: {} nodes, {} elements, {} free DOFs; max |ΦᵀMΦ − I| = {:.2e}",
             tube.structure.beam.mesh.nodes.len(),
             tube.structure.beam.mesh.elements.len(),
             a.mass.nrows(),
             fretdyn::eigen::orthonormality_error(&a.mass, &tube.basis.modes.shapes)
-        );
+        )?;
     }
     let npz = dir.join("basis.npz");
     fretdyn::output::write_basis_npz(&npz, basis).map_err(|e| Failure::failed(e.to_string()))?;
-    println!(
+    outln!(
         "wrote {} (keys: frequencies_hz, damping_ratio, rows_<point>, coords_<point>)",
         npz.display()
-    );
+    )?;
     if let Some(tube) = &case.tube {
         let png = dir.join("mode_shapes.png");
         plot_shapes(&png, &case.title, tube, shown).map_err(Failure::failed)?;
-        println!("wrote {}", png.display());
+        outln!("wrote {}", png.display())?;
     }
     Ok(())
 }

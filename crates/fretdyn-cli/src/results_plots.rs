@@ -80,6 +80,32 @@ fn read_peaks(dir: &Path, contacts: usize) -> Vec<Vec<f64>> {
     peaks
 }
 
+/// Checks what the plots read of `summary.json`: an object with `contacts`, a list of objects
+/// with a `name` each, and `contact_geometry`, a list of as many objects.
+fn check_summary(summary: &Value) -> Result<(), String> {
+    if !summary.is_object() {
+        return Err("not a JSON object".into());
+    }
+    let contacts = summary["contacts"]
+        .as_array()
+        .ok_or("'contacts' is missing or not a list")?;
+    for (k, c) in contacts.iter().enumerate() {
+        if !c["name"].is_string() {
+            return Err(format!("'contacts[{k}].name' is missing or not a string"));
+        }
+    }
+    let geometry = summary["contact_geometry"]
+        .as_array()
+        .ok_or("'contact_geometry' is missing or not a list")?;
+    if geometry.len() != contacts.len() || !geometry.iter().all(Value::is_object) {
+        return Err(format!(
+            "'contact_geometry' must list one object per contact ({})",
+            contacts.len()
+        ));
+    }
+    Ok(())
+}
+
 /// Draws every plot of the run in `dir`; returns the files written.
 pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
     let summary_path = dir.join("summary.json");
@@ -93,6 +119,12 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
                 dir.display()
             ))
         })?;
+    check_summary(&summary).map_err(|e| {
+        Failure::input(format!(
+            "{}: {e}; it is not a summary written by fretdyn run: run the case again",
+            summary_path.display()
+        ))
+    })?;
     let h = read_histories(dir).map_err(Failure::input)?;
     let title = summary["title"].as_str().unwrap_or("fretdyn").to_string();
     let stats = summary["contacts"].as_array().cloned().unwrap_or_default();

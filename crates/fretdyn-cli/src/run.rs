@@ -2,10 +2,12 @@
 //! run that was interrupted; `fretdyn plot DIR` redraws a run's plots.
 //!
 //! Every run is streamed to its folder ([`fretdyn::stream`]): time histories flushed chunk by
-//! chunk, impacts as they end, a checkpoint every `checkpoint_seconds` and on Ctrl-C, so that
-//! a killed run leaves readable results and can be resumed, giving the results of an
-//! uninterrupted run bit for bit.
+//! chunk, impacts as they end, a checkpoint every `checkpoint_seconds` and on Ctrl-C or
+//! SIGTERM, so that a killed run leaves readable results and can be resumed, giving the
+//! results of an uninterrupted run bit for bit. A run holds a lock on its folder: a second
+//! run on the same folder is refused.
 
+use std::fs::File;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -19,14 +21,19 @@ use ndarray_npy::NpzReader;
 use serde_json::json;
 
 use crate::Failure;
+use crate::out::{errln, outln};
 use crate::plot::{Series, line_plot};
 use crate::progress::Bar;
 
-/// Set by Ctrl-C: the run stops at its next progress report, after a checkpoint.
+/// Set by Ctrl-C or SIGTERM: the run stops at its next progress report, after a checkpoint.
 pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// The file that records which case a run folder belongs to, for `--resume`.
 const RUN_FILE: &str = "run.json";
+
+/// The file a run holds an advisory lock on (`flock`) while it writes in its folder; the
+/// lock goes with the process, however it ends.
+const LOCK_FILE: &str = ".fretdyn.lock";
 
 /// Options of `fretdyn run`.
 pub struct Options {
@@ -54,9 +61,11 @@ pub fn main(case: Option<&Path>, resume: Option<&Path>, options: &Options) -> Re
             // bad input is refused before anything is written
             fretdyn::simulation::Simulation::check(&case.model, &case.settings)
                 .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+            check_disk(&case, path, &dir)?;
             std::fs::create_dir_all(&dir).map_err(|e| {
                 Failure::failed(format!("{}: cannot create the folder: {e}", dir.display()))
             })?;
+            let _lock = lock(&dir)?;
             let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
             let run_file = json!({ "case_file": absolute, "fingerprint": fingerprint.to_string() });
             std::fs::write(dir.join(RUN_FILE), format!("{run_file:#}\n"))
@@ -79,9 +88,126 @@ fn load(path: &Path) -> Result<Case, Failure> {
     let case =
         Case::from_file(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
     for w in &case.warnings {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}");
     }
     Ok(case)
+}
+
+/// The lock of a run folder, held until dropped.
+pub struct FolderLock {
+    #[cfg(unix)]
+    _lock: nix::fcntl::Flock<File>,
+}
+
+/// Takes the lock of the run folder `dir` (which exists), or refuses: another run writes
+/// there. An advisory `flock` on [`LOCK_FILE`] (std's `File::try_lock` would need Rust 1.89);
+/// elsewhere than on Unix, no lock.
+fn lock(dir: &Path) -> Result<FolderLock, Failure> {
+    let path = dir.join(LOCK_FILE);
+    let io = |e: std::io::Error| Failure::failed(format!("{}: {e}", path.display()));
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&path)
+        .map_err(io)?;
+    #[cfg(unix)]
+    {
+        use nix::fcntl::{Flock, FlockArg};
+        use std::io::{Read, Seek, Write};
+        match Flock::lock(file, FlockArg::LockExclusiveNonblock) {
+            Ok(mut lock) => {
+                // who holds it, for the message of the next one (the lock is what counts)
+                let _ = lock
+                    .set_len(0)
+                    .and_then(|_| lock.rewind())
+                    .and_then(|_| writeln!(*lock, "{}", std::process::id()));
+                Ok(FolderLock { _lock: lock })
+            }
+            Err((mut file, nix::errno::Errno::EWOULDBLOCK)) => {
+                let mut holder = String::new();
+                let _ = file.read_to_string(&mut holder);
+                let holder = holder.trim();
+                Err(Failure::input(format!(
+                    "{}: another fretdyn run{} is writing in this folder; wait for it to end, or give another output folder (-o DIR)",
+                    dir.display(),
+                    if holder.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" (process {holder})")
+                    }
+                )))
+            }
+            Err((_, errno)) => Err(io(errno.into())),
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        drop(file);
+        Ok(FolderLock {})
+    }
+}
+
+/// The time histories a streamed run writes, bytes: its samples (`steps / output.every + 1`)
+/// times [`fretdyn::recorder::Recorder::bytes_per_sample`], plus the headers of the files.
+fn series_bytes(case: &Case) -> u64 {
+    let s = &case.settings;
+    let samples = (s.steps / s.output_every.max(1)).saturating_add(1);
+    let per_sample = fretdyn::recorder::Recorder::bytes_per_sample(
+        case.model.basis.modes(),
+        case.model.contacts.len(),
+    );
+    samples.saturating_mul(per_sample).saturating_add(9 * 256)
+}
+
+/// Free space for an unprivileged user on the file system of `dir` (or of its first
+/// existing parent), bytes; `None` when unknown.
+fn free_space(dir: &Path) -> Option<u64> {
+    #[cfg(unix)]
+    {
+        let absolute = std::path::absolute(dir).ok()?;
+        let existing = absolute.ancestors().find(|p| p.exists())?;
+        let stat = nix::sys::statvfs::statvfs(existing).ok()?;
+        Some((stat.blocks_available() as u64).saturating_mul(stat.fragment_size() as u64))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        None
+    }
+}
+
+/// Refuses a run whose time histories cannot fit on the disk of its folder, and warns when
+/// packing them into `results.npz` at the end (as much again, until `series/` is removed)
+/// will not fit.
+fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
+    let Some(free) = free_space(dir) else {
+        return Ok(());
+    };
+    let needed = series_bytes(case);
+    let size = fretdyn::recorder::human_bytes;
+    if needed > free {
+        let raise = needed.div_ceil(free.max(1) / 2 + 1).max(2);
+        return Err(Failure::input(format!(
+            "{}: the run would write {} of time histories in {}, where {} is free: keep fewer samples (multiply output.every by {raise} or more), free some space, or give another output folder (-o DIR)",
+            path.display(),
+            size(needed),
+            dir.display(),
+            size(free)
+        )));
+    }
+    if needed.saturating_mul(2) > free {
+        errln!(
+            "warning: {}: the run will write {} of time histories in {}, where {} is free, and packing them into results.npz at the end needs as much again: free some space before the end (a run stopped by a full disk continues with fretdyn run --resume {})",
+            path.display(),
+            size(needed),
+            dir.display(),
+            size(free),
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 /// Hash of the case file's text: a resumed run must use the case it started with.
@@ -103,6 +229,15 @@ fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
             ))
         })?;
     let path = PathBuf::from(info["case_file"].as_str().unwrap_or_default());
+    let _lock = lock(dir)?;
+    if !dir.join(fretdyn::stream::CHECKPOINT_FILE).exists() {
+        return Err(Failure::input(format!(
+            "{}: the run stopped before its first checkpoint, there is nothing to resume; start it again: fretdyn run {} -o {}",
+            dir.display(),
+            path.display(),
+            dir.display()
+        )));
+    }
     let case = load(&path)?;
     let fingerprint = fingerprint_of(&path)?;
     if info["fingerprint"].as_str() != Some(fingerprint.to_string().as_str()) {
@@ -131,7 +266,7 @@ fn default_dir(title: &str, path: &Path) -> PathBuf {
     PathBuf::from("fretdyn_results").join(stem)
 }
 
-/// Progress bar, Ctrl-C, and `summary.json` rewritten at each checkpoint.
+/// Progress bar, Ctrl-C, and `summary.json` rewritten at each checkpoint and at the end.
 struct Observer<'a> {
     bar: Bar,
     case: &'a Case,
@@ -152,6 +287,11 @@ impl StreamObserver for Observer<'_> {
         let summary = fretdyn::output::summary(self.case, partial);
         // a failure here is reported by the final write
         let _ = fretdyn::output::write_summary(self.dir, &summary);
+    }
+
+    fn finished(&mut self, results: &RunResults) -> fretdyn::Result<()> {
+        let summary = fretdyn::output::summary(self.case, results);
+        fretdyn::output::write_summary(self.dir, &summary).map(|_| ())
     }
 }
 
@@ -194,19 +334,36 @@ pub fn run_and_write(
             &mut observer,
         )
     }
-    .map_err(|e| Failure::input(format!("{source}: {e}")))?;
+    .map_err(|e| {
+        observer.bar.finish();
+        match e {
+            // a failed run (a full disk): what was written up to the last checkpoint stays
+            fretdyn::Error::Io { .. } => Failure::failed(format!(
+                "{source}: {e}{}",
+                if dir.join(fretdyn::stream::CHECKPOINT_FILE).exists() {
+                    format!(
+                        "; once fixed (room on the disk), continue the run with: fretdyn run --resume {}",
+                        dir.display()
+                    )
+                } else {
+                    String::new()
+                }
+            )),
+            e => Failure::input(format!("{source}: {e}")),
+        }
+    })?;
     observer.bar.finish();
-    let io = |e: fretdyn::Error| Failure::failed(e.to_string());
-    let summary = fretdyn::output::summary(case, &results);
-    fretdyn::output::write_summary(dir, &summary).map_err(io)?;
     if options.plots {
         crate::results_plots::plot_run(dir)?;
     }
-    if !options.quiet {
-        report(case, &results, dir);
-    }
+    // a full standard output fails the command, but after a failure of the run itself
+    let printed = if options.quiet {
+        Ok(())
+    } else {
+        report(case, &results, dir)
+    };
     match &results.termination {
-        Termination::Completed | Termination::InProgress { .. } => Ok(results),
+        Termination::Completed | Termination::InProgress { .. } => printed.map(|_| results),
         Termination::Diverged {
             step,
             time,
@@ -240,8 +397,8 @@ fn read_friction(dir: &Path) -> Result<(Vec<f64>, Array3<f64>), Failure> {
     Ok((t.to_vec(), f))
 }
 
-fn report(case: &Case, r: &RunResults, dir: &Path) {
-    println!(
+fn report(case: &Case, r: &RunResults, dir: &Path) -> Result<(), Failure> {
+    outln!(
         "{}: {} steps of {:e} s ({} method) in {:.3} s, {:.3e} steps/s",
         case.title,
         r.steps,
@@ -249,13 +406,19 @@ fn report(case: &Case, r: &RunResults, dir: &Path) {
         case.settings.method.name(),
         r.wall_time,
         r.steps_per_second()
-    );
-    println!(
+    )?;
+    outln!(
         "  {:<16} {:>8} {:>8} {:>8} {:>8} {:>12} {:>14}",
-        "contact", "impacts", "contact", "stick", "slip", "max R_N (N)", "wear rate (W)"
-    );
+        "contact",
+        "impacts",
+        "contact",
+        "stick",
+        "slip",
+        "max R_N (N)",
+        "wear rate (W)"
+    )?;
     for c in &r.contacts {
-        println!(
+        outln!(
             "  {:<16} {:>8} {:>8.4} {:>8.4} {:>8.4} {:>12.5e} {:>14.5e}",
             c.name,
             c.impacts,
@@ -264,15 +427,15 @@ fn report(case: &Case, r: &RunResults, dir: &Path) {
             c.slip_time_fraction,
             c.normal_force_max,
             c.wear_work_rate
-        );
+        )?;
     }
-    println!(
+    outln!(
         "  energy balance error {:.3e} (relative)",
         r.energy.relative_error
-    );
+    )?;
     let s = &r.solver;
     if case.settings.method.is_lagrange() {
-        println!(
+        outln!(
             "  solver: GS sweeps mean {:.2} max {} non-converged {}; AS iterations mean {:.2} max {} cycles {} fallbacks {}; singular H {}; residual mean {:.1e} max {:.1e}, steps > 1e-8: {}",
             s.gs_sweeps_mean(),
             s.gs_sweeps_max,
@@ -285,9 +448,9 @@ fn report(case: &Case, r: &RunResults, dir: &Path) {
             s.residual_mean(),
             s.residual_max,
             s.residual_steps_above_1e_8
-        );
+        )?;
     }
-    println!("  wrote {}", dir.display());
+    outln!("  wrote {}", dir.display())
 }
 
 /// The built-in demo: V1a (THEORY §6) with the Active Set, the Gauss–Seidel and the penalty
@@ -300,9 +463,9 @@ fn demo(options: &Options) -> Result<(), Failure> {
         .unwrap_or_else(|| PathBuf::from("fretdyn_results").join("demo_v1a"));
     let v1 = V1::reference(20.0);
     if !quiet {
-        println!(
+        outln!(
             "fretdyn demo: V1a, a 1 kg point mass hitting a plane at 1 m/s, 20° from the normal, μ = 0.3 (THEORY §6)"
-        );
+        )?;
     }
     let mut curves = Vec::new();
     for (label, method) in fretdyn::verification::methods(&[1e6]) {
@@ -313,6 +476,7 @@ fn demo(options: &Options) -> Result<(), Failure> {
             Failure::failed(format!("{}: cannot create the folder: {e}", sub.display()))
         })?;
         let fingerprint = fretdyn::stream::fnv1a(case.title.as_bytes());
+        let _lock = lock(&sub)?;
         run_and_write(&case, "demo", &sub, options, fingerprint, false)?;
         let (t, f) = read_friction(&sub)?;
         let magnitude: Vec<f64> = (0..t.len())
@@ -348,10 +512,10 @@ fn demo(options: &Options) -> Result<(), Failure> {
         .map_err(Failure::failed)?;
     }
     if !quiet {
-        println!(
+        outln!(
             "demo written to {} (one folder per method, and friction_force.png)",
             dir.display()
-        );
+        )?;
     }
     Ok(())
 }

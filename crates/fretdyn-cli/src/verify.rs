@@ -9,6 +9,7 @@ use fretdyn::verification::{Check, V1, V1Measurements, checks, measure, methods}
 use serde_json::json;
 
 use crate::Failure;
+use crate::out::outln;
 use crate::plot::{Series, line_plot};
 
 /// Penalty stiffnesses compared (THEORY §6), N/m.
@@ -68,25 +69,25 @@ pub fn main(dir: &Path, quiet: bool) -> Result<(), Failure> {
         .map_err(|e| Failure::failed(format!("V1a full-step: {e}")))?;
     let full_m = measure(&v1a, &full);
 
-    print_table(&all_checks, quiet);
+    print_table(&all_checks, quiet)?;
     if !quiet {
-        println!(
+        outln!(
             "paper's literal full-step constraint (V1a, Gauss–Seidel): max |R_T| after t*+2Δt = {:.4} × max R_N ({:.1} N), leaving tangential speed {:.3e} m/s",
             full_m.post_stick_force,
             full_m.post_stick_force * max_normal(&full),
             full_m.leaving_tangential_speed
-        );
+        )?;
         for run in runs
             .iter()
             .filter(|r| r.case == "V1a" && r.label.starts_with("penalty"))
         {
-            println!(
+            outln!(
                 "V1a {}: wear work {:.4e} J (analytic {:.4e} J), leaving tangential speed {:.3e} m/s",
                 run.label,
                 run.results.contacts[0].wear_work,
                 analytic_wear_work(&v1a),
                 run.measurements.leaving_tangential_speed
-            );
+            )?;
         }
     }
     figures(dir, &runs, &full).map_err(Failure::failed)?;
@@ -108,12 +109,12 @@ pub fn main(dir: &Path, quiet: bool) -> Result<(), Failure> {
     )
     .map_err(|e| Failure::failed(format!("{}: {e}", path.display())))?;
     let failed = all_checks.iter().filter(|c| !c.passed).count();
-    println!(
+    outln!(
         "verify: {} passed, {} failed; figures and verification.json in {}",
         all_checks.len() - failed,
         failed,
         dir.display()
-    );
+    )?;
     if failed > 0 {
         return Err(Failure::failed(format!(
             "{failed} verification check(s) failed (see the table above)"
@@ -132,16 +133,20 @@ fn max_normal(r: &RunResults) -> f64 {
     r.recorder.normal_force.iter().copied().fold(0.0, f64::max)
 }
 
-fn print_table(checks: &[Check], quiet: bool) {
+fn print_table(checks: &[Check], quiet: bool) -> Result<(), Failure> {
     if !quiet {
-        println!(
+        outln!(
             "{:<7} {:<18} {:<42} {:>12} {:>10}  ok",
-            "case", "method", "quantity", "value", "limit"
-        );
+            "case",
+            "method",
+            "quantity",
+            "value",
+            "limit"
+        )?;
     }
     for c in checks {
         if !quiet || !c.passed {
-            println!(
+            outln!(
                 "{:<7} {:<18} {:<42} {:>12.3e} {:>10.1e}  {}",
                 c.case,
                 c.method,
@@ -149,9 +154,10 @@ fn print_table(checks: &[Check], quiet: bool) {
                 c.value,
                 c.limit,
                 if c.passed { "yes" } else { "NO" }
-            );
+            )?;
         }
     }
+    Ok(())
 }
 
 fn magnitude(r: &RunResults) -> Vec<f64> {

@@ -277,11 +277,9 @@ fn modes_prints_the_table_and_writes_basis_and_picture() {
     assert_eq!(back.basis.points.len(), 2);
 }
 
-/// Step of the last checkpoint in a run folder (`checkpoint.bin`: version u32, fingerprint
-/// u64, then the snapshot, whose first field is the step, u64 little-endian).
+/// Step of the last checkpoint in a run folder, if there is one.
 fn checkpoint_step(dir: &Path) -> Option<u64> {
-    let bytes = std::fs::read(dir.join("checkpoint.bin")).ok()?;
-    Some(u64::from_le_bytes(bytes.get(12..20)?.try_into().ok()?))
+    fretdyn::stream::checkpoint_step(dir).ok()
 }
 
 fn npz_f64(dir: &Path, key: &str) -> ndarray::ArrayD<f64> {
@@ -444,4 +442,468 @@ fn turbulence_tube_killed_at_half_time_resumes_bit_for_bit() {
     assert_eq!(summary(&interrupted)["contacts"], a["contacts"]);
     let (x, y) = (npz_f64(&full, "q"), npz_f64(&interrupted, "q"));
     assert!(x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()));
+
+    // SIGTERM (timeout, batch schedulers, docker stop): as Ctrl-C
+    let child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args([
+            "run",
+            case,
+            "-o",
+            "terminated",
+            "-q",
+            "--no-plots",
+            "--checkpoint-every",
+            "0.2",
+        ])
+        .current_dir(&s.0)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let terminated = s.0.join("terminated");
+    while checkpoint_step(&terminated).is_none_or(|n| n < 200_000) {
+        assert!(start.elapsed().as_secs() < 1800, "no checkpoint");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "killed by SIGTERM: {stderr}");
+    assert!(
+        stderr.contains("interrupted at step") && stderr.contains("--resume"),
+        "{stderr}"
+    );
+    assert_eq!(summary(&terminated)["termination"]["status"], "stopped");
+    let stopped_at = checkpoint_step(&terminated).unwrap();
+    assert!((200_000..1_000_000).contains(&stopped_at), "{stopped_at}");
+    let out = fretdyn(&["run", "--resume", "terminated", "-q", "--no-plots"], &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for key in ["t", "q", "qdot", "contact_normal_force", "contact_position"] {
+        let (x, y) = (npz_f64(&full, key), npz_f64(&terminated, key));
+        assert_eq!(x.shape(), y.shape(), "{key}");
+        assert!(
+            x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()),
+            "{key} differs"
+        );
+    }
+    assert_eq!(summary(&terminated)["contacts"], a["contacts"]);
+    assert_eq!(
+        std::fs::read_to_string(full.join("impacts.csv")).unwrap(),
+        std::fs::read_to_string(terminated.join("impacts.csv")).unwrap()
+    );
+}
+
+/// Checks a refusal: exit code `code`, one line on stderr starting with "error: " and
+/// containing every needle, no panic.
+fn assert_one_line_error(out: &Output, code: i32, needles: &[&str]) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{stderr}");
+    assert_eq!(
+        stderr.trim_end().lines().count(),
+        1,
+        "not one line: {stderr}"
+    );
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    for n in needles {
+        assert!(stderr.contains(n), "'{n}' not in: {stderr}");
+    }
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+/// The turbulence tube, run for `duration` simulated seconds (10 s: about a million steps).
+fn long_case(dir: &Path, duration: f64) -> PathBuf {
+    let text = std::fs::read_to_string(examples().join("tube_turbulence.toml"))
+        .unwrap()
+        .replace("duration = 10.0", &format!("duration = {duration:?}"));
+    assert!(text.contains(&format!("duration = {duration:?}")));
+    let path = dir.join("long.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Waits until `path` exists.
+fn wait_for(path: &Path, child: &mut std::process::Child) {
+    let start = std::time::Instant::now();
+    while !path.exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before {} was written",
+            path.display()
+        );
+        assert!(
+            start.elapsed().as_secs() < 120,
+            "{} not written",
+            path.display()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
+/// A closed standard output (`| head -1`) neither panics nor stops the command's work; a
+/// full one (`> /dev/full`) is a one-line error with exit code 1.
+#[test]
+fn closed_or_full_stdout_is_not_a_panic() {
+    let s = Scratch::new("stdout");
+    let tube = examples().join("tube_clamped_one_support.toml");
+    let tube = tube.to_str().unwrap();
+    // the reader is gone before the first line
+    for args in [
+        vec!["modes", tube, "-o", "m"],
+        vec!["verify", "-o", "v"],
+        vec!["run", "-o", "demo"],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+            .args(&args)
+            .current_dir(&s.0)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
+        assert!(stderr.is_empty(), "{args:?}: {stderr}");
+    }
+    // and the command did its work
+    for f in [
+        "m/basis.npz",
+        "m/mode_shapes.png",
+        "v/verification.json",
+        "demo/friction_force.png",
+    ] {
+        assert!(s.0.join(f).is_file(), "{f}");
+    }
+    // as a shell does it: the first line, then the pipe closes
+    let out = Command::new("bash")
+        .args([
+            "-c",
+            "set -o pipefail; \"$0\" modes \"$1\" -o m2 | head -1",
+            env!("CARGO_BIN_EXE_fretdyn"),
+            tube,
+        ])
+        .current_dir(&s.0)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let case = examples().join("v1a_oblique_impact.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args(["run", case.to_str().unwrap(), "-o", "r", "--no-plots"])
+        .current_dir(&s.0)
+        .stdout(full)
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, 1, &["standard output", "No space left on device"]);
+    assert!(s.0.join("r/results.npz").is_file());
+}
+
+/// A run killed before its first checkpoint cannot be resumed: say so, and how to start it
+/// again.
+#[test]
+fn resume_before_the_first_checkpoint_says_to_start_again() {
+    let s = Scratch::new("nocheckpoint");
+    let case = long_case(&s.0, 100.0);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "-o",
+            "out",
+            "-q",
+            "--checkpoint-every",
+            "100000",
+        ])
+        .current_dir(&s.0)
+        .spawn()
+        .unwrap();
+    wait_for(&s.0.join("out/series/t.npy"), &mut child);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(!s.0.join("out/checkpoint.bin").exists());
+    let out = fretdyn(&["run", "--resume", "out"], &s.0);
+    assert_one_line_error(
+        &out,
+        2,
+        &[
+            "out",
+            "before its first checkpoint",
+            "nothing to resume",
+            "fretdyn run",
+            "long.toml",
+        ],
+    );
+}
+
+/// Two runs on one folder: the second is refused, naming the folder; the first goes on.
+#[test]
+fn a_second_run_on_the_same_folder_is_refused() {
+    let s = Scratch::new("lock");
+    let case = long_case(&s.0, 100.0);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "-o",
+            "out",
+            "-q",
+            "--no-plots",
+        ])
+        .current_dir(&s.0)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_for(&s.0.join("out/series/t.npy"), &mut child);
+    let v1a = examples().join("v1a_oblique_impact.toml");
+    let out = fretdyn(&["run", v1a.to_str().unwrap(), "-o", "out", "-q"], &s.0);
+    assert_one_line_error(&out, 2, &["out", "another fretdyn run", "-o"]);
+    let out = fretdyn(&["run", "--resume", "out", "-q"], &s.0);
+    assert_one_line_error(&out, 2, &["out", "another fretdyn run"]);
+    // the first is untouched: it stops on Ctrl-C as usual, with its own case
+    assert!(child.try_wait().unwrap().is_none(), "the first run ended");
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted at step"), "{stderr}");
+    let run: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(s.0.join("out/run.json")).unwrap()).unwrap();
+    assert!(run["case_file"].as_str().unwrap().ends_with("long.toml"));
+    // once it ended, the folder is free again
+    let out = fretdyn(&["run", v1a.to_str().unwrap(), "-o", "out", "-q"], &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Command-line errors are one line with a hint to the help, exit code 2.
+#[test]
+fn command_line_errors_are_one_line() {
+    let s = Scratch::new("clap");
+    let v1a = examples().join("v1a_oblique_impact.toml");
+    let v1a = v1a.to_str().unwrap();
+    let out = fretdyn(&["run", v1a, "--bogus"], &s.0);
+    assert_one_line_error(&out, 2, &["--bogus", "fretdyn run --help"]);
+    let out = fretdyn(&["run", v1a, "-o", ""], &s.0);
+    assert_one_line_error(&out, 2, &["--output", "empty", "fretdyn run --help"]);
+    let out = fretdyn(&["bench", "--steps", "many"], &s.0);
+    assert_one_line_error(&out, 2, &["--steps", "many", "fretdyn bench --help"]);
+    let out = fretdyn(&["rnu"], &s.0);
+    assert_one_line_error(&out, 2, &["rnu", "fretdyn --help"]);
+    assert!(
+        std::fs::read_dir(&s.0).unwrap().next().is_none(),
+        "nothing written"
+    );
+    // the help is still the help
+    let out = fretdyn(&["run", "--help"], &s.0);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("--resume"));
+}
+
+/// `fretdyn plot` on a summary.json that is JSON but not a summary: refused, naming the file.
+#[test]
+fn plot_refuses_a_malformed_summary() {
+    let s = Scratch::new("plotsummary");
+    let v1a = examples().join("v1a_oblique_impact.toml");
+    let out = fretdyn(
+        &[
+            "run",
+            v1a.to_str().unwrap(),
+            "-o",
+            "out",
+            "-q",
+            "--no-plots",
+        ],
+        &s.0,
+    );
+    assert!(out.status.success());
+    for bad in [
+        "{}",
+        "[1, 2]",
+        "{\"contacts\": 5}",
+        "{\"contacts\": [{\"name\": 1}], \"contact_geometry\": [{}]}",
+        "{\"contacts\": [{\"name\": \"plane\"}]}",
+    ] {
+        std::fs::write(s.0.join("out/summary.json"), bad).unwrap();
+        let out = fretdyn(&["plot", "out"], &s.0);
+        assert_one_line_error(&out, 2, &["summary.json"]);
+        assert!(!s.0.join("out/contact_forces.png").exists(), "{bad}");
+    }
+}
+
+/// A case whose time histories cannot fit on the disk is refused before it starts (not after
+/// hours), with the figure and the fix; nothing is written.
+#[test]
+fn a_run_larger_than_the_disk_is_refused() {
+    let s = Scratch::new("disk");
+    // 9e11 steps of 121 bytes (t, q, q̇ of 3 modes, 65 bytes of one contact): 109 TB
+    let case = V1A.replace("duration = 4e-3", "duration = 9e5");
+    std::fs::write(s.0.join("case.toml"), case).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args(["run", "case.toml", "-o", "out", "-q"])
+        .current_dir(&s.0)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed().as_secs() > 60 {
+            child.kill().unwrap();
+            panic!("the run was not refused");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
+    assert_one_line_error(&out, 2, &["case.toml", "108.9 TB", "free", "output.every"]);
+    assert!(!s.0.join("out").exists());
+}
+
+/// The packing of results.npz fails (here: a file-size limit, as `ulimit -f`; the same path
+/// as a full disk): the run fails (exit 1) with one line and the way to continue; `--resume`
+/// then packs it, with the results of an uninterrupted run.
+#[test]
+fn a_run_that_fails_while_packing_is_finished_by_resume() {
+    let s = Scratch::new("pack");
+    let v1a = examples().join("v1a_oblique_impact.toml");
+    let v1a = v1a.to_str().unwrap();
+    let out = fretdyn(&["run", v1a, "-o", "full", "-q", "--no-plots"], &s.0);
+    assert!(out.status.success());
+    // 4001 samples: each series file is under 100 kB, results.npz is about 490 kB
+    let out = Command::new("bash")
+        .args([
+            "-c",
+            "ulimit -f 300; trap '' XFSZ; exec \"$0\" run \"$1\" -o out -q --no-plots",
+            env!("CARGO_BIN_EXE_fretdyn"),
+            v1a,
+        ])
+        .current_dir(&s.0)
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, 1, &["results.npz", "fretdyn run --resume out"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("ZipWriter"));
+    assert!(!s.0.join("out/results.npz").exists());
+    resumed_equals(&s.0, "out", &s.0.join("full"));
+}
+
+/// `--resume DIR` succeeds, and DIR then holds the results of the run in `full`.
+fn resumed_equals(cwd: &Path, dir: &str, full: &Path) {
+    let out = fretdyn(&["run", "--resume", dir, "-q", "--no-plots"], cwd);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let dir = cwd.join(dir);
+    for key in [
+        "t",
+        "q",
+        "qdot",
+        "contact_normal_force",
+        "contact_tangential_force",
+    ] {
+        let (a, b) = (npz_f64(full, key), npz_f64(&dir, key));
+        assert_eq!(a.shape(), b.shape(), "{key}");
+        assert!(
+            a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+            "{key} differs"
+        );
+    }
+    assert!(!dir.join("series").exists());
+    let summary = |d: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap()
+    };
+    let (a, b) = (summary(full), summary(&dir));
+    assert_eq!(b["termination"]["status"], "completed");
+    for key in ["contacts", "energy_balance", "time"] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(full.join("impacts.csv")).unwrap(),
+        std::fs::read_to_string(dir.join("impacts.csv")).unwrap()
+    );
+    // and then it is complete
+    let out = fretdyn(&["run", "--resume", dir.to_str().unwrap(), "-q"], cwd);
+    assert_one_line_error(&out, 2, &["nothing to resume"]);
+}
+
+/// A real full disk (a small tmpfs; needs the right to mount, skipped without it): a warning
+/// before the run that packing will not fit, a one-line failure (exit 1) while packing, and
+/// `--resume` finishes the run once there is room.
+#[test]
+fn a_full_disk_while_packing_is_resumed_once_there_is_room() {
+    let s = Scratch::new("tmpfs");
+    let v1a = examples().join("v1a_oblique_impact.toml");
+    let v1a = v1a.to_str().unwrap();
+    let out = fretdyn(&["run", v1a, "-o", "full", "-q", "--no-plots"], &s.0);
+    assert!(out.status.success());
+    let disk = s.0.join("disk");
+    std::fs::create_dir_all(&disk).unwrap();
+    // the series (about 490 kB) fit, not twice
+    let mounted = Command::new("mount")
+        .args([
+            "-t",
+            "tmpfs",
+            "-o",
+            "size=800k",
+            "tmpfs",
+            disk.to_str().unwrap(),
+        ])
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !mounted {
+        eprintln!("skipped: cannot mount a tmpfs here");
+        return;
+    }
+    struct Unmount(PathBuf);
+    impl Drop for Unmount {
+        fn drop(&mut self) {
+            let _ = Command::new("umount").arg(&self.0).status();
+        }
+    }
+    let _unmount = Unmount(disk.clone());
+    let out = fretdyn(&["run", v1a, "-o", "disk/out", "-q", "--no-plots"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 2, "a warning and an error: {stderr}");
+    assert!(
+        lines[0].starts_with("warning: ") && lines[0].contains("results.npz"),
+        "{stderr}"
+    );
+    assert!(lines[1].starts_with("error: "), "{stderr}");
+    for needle in ["No space left on device", "fretdyn run --resume disk/out"] {
+        assert!(lines[1].contains(needle), "{needle}: {stderr}");
+    }
+    assert!(
+        !stderr.contains("ZipWriter") && !stderr.contains("Os {"),
+        "{stderr}"
+    );
+    // still no room: the same failure, and the run is still resumable
+    let out = fretdyn(&["run", "--resume", "disk/out", "-q", "--no-plots"], &s.0);
+    assert_one_line_error(&out, 1, &["No space left on device", "--resume"]);
+    let remount = Command::new("mount")
+        .args(["-o", "remount,size=4m", disk.to_str().unwrap()])
+        .status()
+        .unwrap();
+    assert!(remount.success());
+    resumed_equals(&s.0, "disk/out", &s.0.join("full"));
 }

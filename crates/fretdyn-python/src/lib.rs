@@ -138,9 +138,21 @@ fn case_from_json(json: &str, base_dir: PathBuf) -> PyResult<Case> {
 
 /// Runs a case with the GIL released; Ctrl-C stops it (KeyboardInterrupt). Returns a dict of
 /// numpy arrays (the keys of `results.npz`) and `summary_json`, the text of `summary.json`.
+/// A run whose time histories do not fit in memory twice (the run's, then numpy's copy) is
+/// refused before it starts (FretdynError naming `output.every`), not left to abort the
+/// interpreter.
 #[pyfunction]
 fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
     let c = &case.inner;
+    let s = &c.settings;
+    let samples = (s.steps / s.output_every.max(1)).saturating_add(1);
+    fretdyn::recorder::Recorder::check_memory(
+        samples,
+        c.model.basis.modes(),
+        c.model.contacts.len(),
+        2,
+    )
+    .map_err(err)?;
     let mut interrupted = None;
     let results = py
         .detach(|| {

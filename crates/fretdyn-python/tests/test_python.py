@@ -59,6 +59,19 @@ def test_errors_are_exceptions_with_the_cli_message(tmp_path):
         fretdyn.modal_structure([1.0, 2.0], {"a": np.zeros((3, 3))})
 
 
+def test_a_run_too_large_for_the_memory_is_refused_not_an_abort():
+    # 1e10 steps of V1a, every step kept: 1.2 TB of time histories, which would abort the
+    # interpreter when allocated
+    text = (EXAMPLES / "v1a_oblique_impact.toml").read_text()
+    c = fretdyn.Case.from_toml(text.replace("duration = 4e-3", "duration = 1e4"))
+    assert c.steps == 10_000_000_000
+    with pytest.raises(fretdyn.FretdynError, match="output.every") as e:
+        fretdyn.run(c)
+    assert "TB" in str(e.value) and "fretdyn run" in str(e.value)
+    # and the interpreter is still there to run a case
+    assert fretdyn.run(fretdyn.Case.from_toml(text))["t"].shape == (4001,)
+
+
 def v1a_dict():
     """V1a (examples/v1a_modal_inline.toml) as a dict with numpy arrays."""
     a = np.radians(20.0)

@@ -3,6 +3,8 @@
 
 use ndarray::{Array1, Array2, Array3};
 
+use crate::error::{Error, Result};
+
 /// Time histories at the output samples (every `every`-th step, t = 0 included).
 #[derive(Debug, Clone)]
 pub struct Recorder {
@@ -56,6 +58,44 @@ impl Recorder {
             position: Array3::zeros((samples, c, 2)),
             len: 0,
         }
+    }
+
+    /// Bytes one output sample takes, in memory as in the streamed files: `t`, `q`, `q̇`
+    /// (8 + 16 p), and per contact `R_N`, `R_T`, `v_T`, `δ`, position as `f64` and the status
+    /// as `i8` (65 c). THEORY §5 lists the outputs.
+    pub const fn bytes_per_sample(p: usize, c: usize) -> u64 {
+        8 + 16 * p as u64 + 65 * c as u64
+    }
+
+    /// Refuses, before anything is allocated, time histories of `samples` samples of `p` modes
+    /// and `c` contacts that do not fit in the memory available, `copies` times (a front end
+    /// that copies them out, as the Python package into numpy arrays, needs two):
+    /// `samples × (8 + 16 p + 65 c) × copies` bytes against the memory the system says is
+    /// available (Linux: `MemAvailable`, and the control group's limit; elsewhere only what
+    /// cannot be addressed is refused). The error names `output.every` and the fix.
+    pub fn check_memory(samples: u64, p: usize, c: usize, copies: u64) -> Result<()> {
+        let per_sample = Self::bytes_per_sample(p, c).saturating_mul(copies.max(1));
+        let needed = samples.saturating_mul(per_sample);
+        let available = available_memory().unwrap_or(isize::MAX as u64);
+        if needed <= available {
+            return Ok(());
+        }
+        // samples that fit in half the memory available: every step kept, k-th of them
+        let fit = (available / 2 / per_sample.max(1)).max(1);
+        let raise = samples.div_ceil(fit).max(2);
+        Err(Error::invalid(
+            "output.every",
+            format!(
+                "the run would keep {samples} output samples of {p} modes and {c} contacts in                  memory, {}{}, more than the {} available: keep fewer samples (multiply                  output.every by {raise} or more), or run the case with `fretdyn run`, which                  streams the time histories to disk",
+                human_bytes(needed),
+                if copies > 1 {
+                    format!(" ({copies} copies)")
+                } else {
+                    String::new()
+                },
+                human_bytes(available)
+            ),
+        ))
     }
 
     /// Number of samples written.
@@ -135,5 +175,48 @@ impl Recorder {
         self.penetration = self.penetration.slice(ndarray::s![..n, ..]).to_owned();
         self.status = self.status.slice(ndarray::s![..n, ..]).to_owned();
         self.position = self.position.slice(ndarray::s![..n, .., ..]).to_owned();
+    }
+}
+
+/// Memory the system can give this process, bytes: `MemAvailable` of `/proc/meminfo`, bounded
+/// by the control group's `memory.max − memory.current` (cgroup v2) when there is one; `None`
+/// when neither is known.
+fn available_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| {
+            let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+            let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+            Some(kb.saturating_mul(1024))
+        });
+    let read = |name: &str| -> Option<u64> {
+        std::fs::read_to_string(format!("/sys/fs/cgroup/{name}"))
+            .ok()?
+            .trim()
+            .parse()
+            .ok()
+    };
+    // "max" (no limit) does not parse
+    let cgroup =
+        read("memory.max").map(|max| max.saturating_sub(read("memory.current").unwrap_or(0)));
+    match (meminfo, cgroup) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+/// `bytes` for a person: `1.5 GB` (powers of 1000).
+pub fn human_bytes(bytes: u64) -> String {
+    let units = ["bytes", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut value = bytes as f64;
+    let mut unit = 0;
+    while value >= 1000.0 && unit + 1 < units.len() {
+        value /= 1000.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{bytes} bytes")
+    } else {
+        format!("{value:.1} {}", units[unit])
     }
 }

@@ -276,14 +276,16 @@ pub struct Snapshot {
 }
 
 impl Snapshot {
-    /// Binary encoding (bincode: exact for every `f64`).
+    /// Binary encoding (CBOR: exact for every `f64`).
     pub fn to_bytes(&self) -> Vec<u8> {
-        bincode::serialize(self).expect("a snapshot always serializes")
+        let mut bytes = Vec::new();
+        ciborium::into_writer(self, &mut bytes).expect("a snapshot always serializes");
+        bytes
     }
 
     /// Decodes [`Self::to_bytes`]; `None` when the bytes are not a snapshot.
     pub fn from_bytes(bytes: &[u8]) -> Option<Self> {
-        bincode::deserialize(bytes).ok()
+        ciborium::from_reader(bytes).ok()
     }
 }
 
@@ -389,9 +391,13 @@ impl<'m> Simulation<'m> {
     /// Checks the model and the settings (Δt against the stability limit), allocates
     /// everything the steps need, with room for every output sample of the run, and computes
     /// the state at t = 0 (the first sample).
+    /// A run whose time histories would not fit in memory is refused before anything is
+    /// allocated ([`Recorder::check_memory`]).
     pub fn new(model: &'m Model, settings: &'m RunSettings) -> Result<Self> {
-        let samples = (settings.steps / settings.output_every + 1) as usize;
-        Self::with_recorder(model, settings, samples)
+        settings.validate()?;
+        let samples = settings.steps / settings.output_every + 1;
+        Recorder::check_memory(samples, model.basis.modes(), model.contacts.len(), 1)?;
+        Self::with_recorder(model, settings, samples as usize)
     }
 
     /// As [`Self::new`], with room for `samples` output samples only: the caller drains the

@@ -10,9 +10,14 @@
 //! - `impacts.csv`: the per-impact table, appended as impacts end;
 //! - `blocks.csv`: the per-block statistics (when blocks are set);
 //! - `checkpoint.bin`: the [`Snapshot`] with the length of every file at that step, written to
-//!   a temporary name and renamed;
+//!   a temporary name and renamed; its format is in [`CHECKPOINT_MAGIC`];
 //! - at the end, `results.npz`, packed from `series/` (copied entry by entry, never whole in
 //!   memory), after which `series/` is removed.
+//!
+//! A run ends with a checkpoint at its last step, then [`StreamObserver::finished`] (where a
+//! front end writes its summary), then the packing: a run killed, or out of disk, before
+//! `results.npz` is in place is finished by [`resume`], which does those again; a last
+//! checkpoint with `results.npz` beside it is a complete run.
 //!
 //! Memory does not grow with the run's length: the recorder holds one chunk, finished impacts
 //! and blocks are written out at each flush, and the statistics are running sums.
@@ -59,6 +64,12 @@ pub trait StreamObserver {
     fn progress(&mut self, progress: Progress) -> ControlFlow<()>;
     /// Called after each checkpoint with the statistics so far (its recorder is empty).
     fn checkpoint(&mut self, _partial: &RunResults) {}
+    /// Called once the run has ended (completed, stopped or diverged) and its files but
+    /// `results.npz` are written, before the packing; an error fails the run. A run that
+    /// ended but was not packed (killed, out of disk) calls it again when it is resumed.
+    fn finished(&mut self, _results: &RunResults) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// An observer that only reports progress through a closure.
@@ -77,11 +88,19 @@ pub const IMPACTS_FILE: &str = "impacts.csv";
 pub const BLOCKS_FILE: &str = "blocks.csv";
 pub const RESULTS_FILE: &str = "results.npz";
 
-const CHECKPOINT_VERSION: u32 = 1;
+/// First bytes of `checkpoint.bin`. The file is: these 8 bytes, the format version
+/// ([`CHECKPOINT_FORMAT`], u32 little-endian), the length of the version of fretdyn that
+/// wrote it (u8) and that version (UTF-8, e.g. `0.1.0`), then the checkpoint in CBOR (RFC
+/// 8949; exact for every `f64`). [`resume`] refuses a checkpoint of another format or another
+/// version of fretdyn: a resumed run gives the results of an uninterrupted one only with the
+/// code that started it.
+pub const CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNC";
+
+/// Format version of `checkpoint.bin` (1 was bincode, without a header).
+pub const CHECKPOINT_FORMAT: u32 = 2;
 
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {
-    version: u32,
     fingerprint: u64,
     snapshot: Snapshot,
     /// Rows in every series file at the checkpoint.
@@ -119,20 +138,8 @@ pub fn resume(
     fingerprint: u64,
     observer: &mut dyn StreamObserver,
 ) -> Result<RunResults> {
+    let checkpoint = read_checkpoint(dir)?;
     let path = dir.join(CHECKPOINT_FILE);
-    let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
-    let checkpoint: Checkpoint = bincode::deserialize(&bytes)
-        .ok()
-        .filter(|c: &Checkpoint| c.version == CHECKPOINT_VERSION)
-        .ok_or_else(|| {
-            Error::invalid(
-                "checkpoint",
-                format!(
-                    "{} is not a fretdyn {CHECKPOINT_VERSION} checkpoint",
-                    path.display()
-                ),
-            )
-        })?;
     if checkpoint.fingerprint != fingerprint_with(fingerprint, settings) {
         return Err(Error::invalid(
             "checkpoint",
@@ -142,7 +149,9 @@ pub fn resume(
             ),
         ));
     }
-    if checkpoint.snapshot.step >= settings.steps {
+    if checkpoint.snapshot.step >= settings.steps && dir.join(RESULTS_FILE).exists() {
+        // killed while removing series/, after the packing: what is left is not needed
+        let _ = std::fs::remove_dir_all(dir.join(SERIES_DIR));
         return Err(Error::invalid(
             "checkpoint",
             format!(
@@ -159,7 +168,80 @@ pub fn resume(
         checkpoint.impacts_bytes,
         checkpoint.blocks_bytes,
     )?;
+    // the results.npz of a stop is packed again at the end; until then, a results.npz beside
+    // the last checkpoint is that of a complete run
+    match std::fs::remove_file(dir.join(RESULTS_FILE)) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(Error::io(dir.join(RESULTS_FILE), e));
+        }
+        _ => {}
+    }
     drive(sim, files, settings, stream, fingerprint, observer)
+}
+
+/// Reads the checkpoint of the run in `dir`; an error says why it cannot be resumed.
+fn read_checkpoint(dir: &Path) -> Result<Checkpoint> {
+    let path = dir.join(CHECKPOINT_FILE);
+    let bytes = match std::fs::read(&path) {
+        Ok(bytes) => bytes,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(Error::invalid(
+                "checkpoint",
+                format!(
+                    "{}: the run stopped before its first checkpoint, there is nothing to \
+                     resume: start it again",
+                    dir.display()
+                ),
+            ));
+        }
+        Err(e) => return Err(Error::io(&path, e)),
+    };
+    decode_checkpoint(&bytes)
+        .map_err(|message| Error::invalid("checkpoint", format!("{}: {message}", path.display())))
+}
+
+/// The step of the last checkpoint of the run in `dir` (the steps a resumed run starts after).
+pub fn checkpoint_step(dir: &Path) -> Result<u64> {
+    Ok(read_checkpoint(dir)?.snapshot.step)
+}
+
+fn encode_checkpoint(checkpoint: &Checkpoint) -> std::io::Result<Vec<u8>> {
+    let version = env!("CARGO_PKG_VERSION").as_bytes();
+    let mut bytes = Vec::with_capacity(4096);
+    bytes.extend_from_slice(CHECKPOINT_MAGIC);
+    bytes.extend_from_slice(&CHECKPOINT_FORMAT.to_le_bytes());
+    bytes.push(version.len() as u8);
+    bytes.extend_from_slice(version);
+    ciborium::into_writer(checkpoint, &mut bytes).map_err(std::io::Error::other)?;
+    Ok(bytes)
+}
+
+/// Decodes [`encode_checkpoint`]; the error says what is wrong and what to do.
+fn decode_checkpoint(bytes: &[u8]) -> std::result::Result<Checkpoint, String> {
+    let start_again = "start the run again";
+    let Some(rest) = bytes.strip_prefix(CHECKPOINT_MAGIC) else {
+        return Err(format!(
+            "not a checkpoint of this fretdyn (an older checkpoint format without a header, or \
+             another file): {start_again}"
+        ));
+    };
+    let truncated = || format!("truncated: {start_again}");
+    let format = u32::from_le_bytes(
+        rest.get(..4)
+            .and_then(|b| b.try_into().ok())
+            .ok_or_else(truncated)?,
+    );
+    let len = *rest.get(4).ok_or_else(truncated)? as usize;
+    let version = rest.get(5..5 + len).ok_or_else(truncated)?;
+    let version = String::from_utf8_lossy(version);
+    let ours = env!("CARGO_PKG_VERSION");
+    if format != CHECKPOINT_FORMAT || version != ours {
+        return Err(format!(
+            "written by fretdyn {version} (checkpoint format {format}), this is fretdyn {ours} \
+             (format {CHECKPOINT_FORMAT}): resume it with fretdyn {version}, or {start_again}"
+        ));
+    }
+    ciborium::from_reader(&rest[5 + len..]).map_err(|e| format!("damaged ({e}): {start_again}"))
 }
 
 /// The step loop of a streamed run.
@@ -225,6 +307,7 @@ fn drive(
     files.write_impacts(&results.impacts)?;
     files.write_blocks(&results.blocks)?;
     files.sync()?;
+    observer.finished(&results)?;
     files.pack(matches!(results.termination, Termination::Completed))?;
     results.impacts.clear();
     results.blocks.clear();
@@ -237,7 +320,8 @@ fn partial(sim: &Simulation, start: Instant) -> RunResults {
 }
 
 fn fingerprint_with(fingerprint: u64, settings: &RunSettings) -> u64 {
-    let bytes = bincode::serialize(settings).unwrap_or_default();
+    let mut bytes = Vec::new();
+    let _ = ciborium::into_writer(settings, &mut bytes);
     fnv1a(fingerprint.to_le_bytes().iter().chain(&bytes))
 }
 
@@ -455,19 +539,14 @@ impl Files {
         let impacts_bytes = position(&mut self.impacts, IMPACTS_FILE)?;
         let blocks_bytes = position(&mut self.blocks, BLOCKS_FILE)?;
         let checkpoint = Checkpoint {
-            version: CHECKPOINT_VERSION,
             fingerprint,
             snapshot: sim.snapshot(),
             rows: self.series[0].rows,
             impacts_bytes,
             blocks_bytes,
         };
-        let bytes = bincode::serialize(&checkpoint).map_err(|e| {
-            Error::io(
-                self.dir.join(CHECKPOINT_FILE),
-                std::io::Error::other(e.to_string()),
-            )
-        })?;
+        let bytes = encode_checkpoint(&checkpoint)
+            .map_err(|e| Error::io(self.dir.join(CHECKPOINT_FILE), e))?;
         crate::output::write_atomically(&self.dir.join(CHECKPOINT_FILE), |mut f| {
             f.write_all(&bytes)?;
             f.sync_data()
@@ -484,7 +563,9 @@ impl Files {
             .map(|s| (s.key.clone(), s.path.clone()))
             .collect();
         crate::output::write_atomically(&path, |file| {
-            let mut zip = zip::ZipWriter::new(BufWriter::new(file));
+            // after an error (a full disk), the writer swallows what the ZipWriter's drop
+            // writes: the error is reported once, by the caller, and the file removed
+            let mut zip = zip::ZipWriter::new(BufWriter::new(FailOnce::new(file)));
             let options = zip::write::SimpleFileOptions::default()
                 .compression_method(zip::CompressionMethod::Stored)
                 .large_file(true);
@@ -501,6 +582,61 @@ impl Files {
             let _ = std::fs::remove_dir_all(self.dir.join(SERIES_DIR));
         }
         Ok(())
+    }
+}
+
+/// A file that, once a write, flush or seek failed, accepts everything silently: for the
+/// [`zip::ZipWriter`], which on drop tries to finish the archive after an error and prints
+/// that second failure.
+struct FailOnce {
+    file: File,
+    failed: bool,
+}
+
+impl FailOnce {
+    fn new(file: File) -> Self {
+        Self {
+            file,
+            failed: false,
+        }
+    }
+
+    fn guard<T>(&mut self, r: std::io::Result<T>, instead: T) -> std::io::Result<T> {
+        if self.failed {
+            return Ok(instead);
+        }
+        if r.is_err() {
+            self.failed = true;
+        }
+        r
+    }
+}
+
+impl Write for FailOnce {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.failed {
+            return Ok(buf.len());
+        }
+        let r = self.file.write(buf);
+        self.guard(r, buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        if self.failed {
+            return Ok(());
+        }
+        let r = self.file.flush();
+        self.guard(r, ())
+    }
+}
+
+impl Seek for FailOnce {
+    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
+        if self.failed {
+            return Ok(0);
+        }
+        let r = self.file.seek(pos);
+        self.guard(r, 0)
     }
 }
 

@@ -23,12 +23,13 @@ use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+use std::time::Instant;
 
 use serde::Deserialize;
 
 use crate::case::Case;
 use crate::error::{Error, Result};
-use crate::simulation::{Termination, simulate};
+use crate::simulation::{RunResults, Simulation, Termination};
 
 /// How the parameters' values are combined into runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -339,10 +340,11 @@ impl Study {
         Ok(total)
     }
 
-    /// Runs one run and formats its row.
+    /// Runs one run and formats its row. Only the statistics are kept
+    /// ([`run_statistics`]): memory does not grow with the length of the run.
     pub fn run_row(&self, run: &RunSpec) -> Result<String> {
         let case = self.case(run)?;
-        let r = simulate(&case.model, &case.settings)?;
+        let r = run_statistics(&case)?;
         let mut cols = vec![run.index.to_string()];
         cols.extend(run.values.iter().map(csv_value));
         cols.push(run.seed.map(|s| s.to_string()).unwrap_or_default());
@@ -363,6 +365,32 @@ impl Study {
         }
         Ok(cols.join(","))
     }
+}
+
+/// Runs `case` for its statistics (THEORY §5) only: neither the time histories (a recorder of
+/// one sample, emptied when full) nor the list of impacts and blocks are kept, so that memory
+/// does not grow with the run's length. The statistics are those of
+/// [`crate::simulation::simulate`] (running sums, which do not depend on what is recorded).
+pub fn run_statistics(case: &Case) -> Result<RunResults> {
+    let start = Instant::now();
+    let mut sim = Simulation::with_recorder(&case.model, &case.settings, 1)?;
+    let total = case.settings.steps;
+    let mut termination = Termination::Completed;
+    while sim.steps_done() < total {
+        if let Err(d) = sim.step() {
+            termination = d.into_termination(&case.model);
+            break;
+        }
+        if sim.recorder().is_full() {
+            sim.recorder_mut().clear();
+        }
+        if sim.steps_done() % 1024 == 0 {
+            let statistics = sim.statistics_mut();
+            statistics.impacts.clear();
+            statistics.blocks.clear();
+        }
+    }
+    Ok(sim.finish(start.elapsed().as_secs_f64(), termination))
 }
 
 fn csv_value(v: &toml::Value) -> String {

@@ -199,6 +199,113 @@ fn streamed_run_equals_the_run_in_memory_and_resumes_bit_for_bit() {
     std::fs::remove_dir_all(&tmp).ok();
 }
 
+/// Killed after its last checkpoint, before `results.npz` was packed (or out of disk while
+/// packing): `resume` packs it, with the results of an uninterrupted run; then it is complete.
+#[test]
+fn a_run_killed_before_packing_is_finished_by_resume() {
+    let steps = 4096;
+    let case = tube_case(steps);
+    let tmp = tempdir().join("packing");
+    let full = tmp.join("full");
+    let r_full = stream::run(
+        &case.model,
+        &case.settings,
+        &full,
+        &stream_settings(Some(1024)),
+        7,
+        &mut ProgressOnly(|_| ControlFlow::Continue(())),
+    )
+    .unwrap();
+    // the last progress report comes after the last checkpoint, before the packing
+    let killed = tmp.join("killed");
+    let died = std::panic::catch_unwind(|| {
+        stream::run(
+            &case.model,
+            &case.settings,
+            &killed,
+            &stream_settings(Some(1024)),
+            7,
+            &mut DieAt(steps),
+        )
+    });
+    assert!(died.is_err());
+    assert_eq!(stream::checkpoint_step(&killed).unwrap(), steps);
+    assert!(!killed.join("results.npz").exists());
+    let r = resume(&case, &killed, 7).unwrap();
+    same_statistics(&r_full, &r);
+    assert_eq!(r.termination, Termination::Completed);
+    assert_eq!(read(&killed), read(&full));
+    assert_eq!(text(&killed, "impacts.csv"), text(&full, "impacts.csv"));
+    assert_eq!(text(&killed, "blocks.csv"), text(&full, "blocks.csv"));
+    assert!(!killed.join("series").exists());
+    let err = resume(&case, &killed, 7).unwrap_err();
+    assert!(err.to_string().contains("complete"), "{err}");
+    std::fs::remove_dir_all(&tmp).ok();
+}
+
+/// `checkpoint.bin` is `FRETDYNC`, the format (u32 LE), the version of fretdyn (u8 length,
+/// UTF-8), then CBOR; a checkpoint of another format or version, or without the header (the
+/// bincode checkpoints of format 1), is refused with what to do; the file itself resumes.
+#[test]
+fn a_checkpoint_of_another_version_is_refused() {
+    let case = tube_case(4096);
+    let tmp = tempdir().join("versions");
+    let dir = tmp.join("stopped");
+    stream::run(
+        &case.model,
+        &case.settings,
+        &dir,
+        &stream_settings(None),
+        7,
+        &mut StopAt(2048),
+    )
+    .unwrap();
+    let path = dir.join("checkpoint.bin");
+    let bytes = std::fs::read(&path).unwrap();
+    let version = env!("CARGO_PKG_VERSION");
+    assert_eq!(&bytes[..8], b"FRETDYNC");
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
+    assert_eq!(bytes[12] as usize, version.len());
+    assert_eq!(&bytes[13..13 + version.len()], version.as_bytes());
+    let payload = &bytes[13 + version.len()..];
+    let with_header = |format: u32, version: &str| {
+        let mut b = b"FRETDYNC".to_vec();
+        b.extend_from_slice(&format.to_le_bytes());
+        b.push(version.len() as u8);
+        b.extend_from_slice(version.as_bytes());
+        b.extend_from_slice(payload);
+        b
+    };
+    let refused = |bytes: Vec<u8>, needles: &[&str]| {
+        std::fs::write(&path, bytes).unwrap();
+        let err = resume(&case, &dir, 7).unwrap_err().to_string();
+        for n in needles {
+            assert!(err.contains(n), "'{n}' not in: {err}");
+        }
+        assert!(err.contains("checkpoint.bin"), "{err}");
+        assert!(err.contains("start the run again"), "{err}");
+    };
+    refused(
+        with_header(2, "9.9.9"),
+        &[
+            "written by fretdyn 9.9.9",
+            &format!("this is fretdyn {version}"),
+        ],
+    );
+    refused(with_header(3, version), &["checkpoint format 3"]);
+    // format 1: bincode, starting with its version (1u32) and the fingerprint
+    let mut old = 1u32.to_le_bytes().to_vec();
+    old.extend_from_slice(&7u64.to_le_bytes());
+    old.extend_from_slice(payload);
+    refused(old, &["not a checkpoint of this fretdyn"]);
+    refused(with_header(2, version)[..40].to_vec(), &["damaged"]);
+    // the checkpoint as written resumes
+    std::fs::write(&path, &bytes).unwrap();
+    let r = resume(&case, &dir, 7).unwrap();
+    assert_eq!(r.termination, Termination::Completed);
+    std::fs::remove_dir_all(&tmp).ok();
+}
+
 /// Resumes the run in `dir` to its end.
 fn resume(case: &Case, dir: &Path, fingerprint: u64) -> fretdyn::Result<RunResults> {
     stream::resume(
