@@ -12,8 +12,7 @@ use crate::plot::{Series, panels_plot};
 
 /// Entry point of `fretdyn modes`.
 pub fn main(path: &Path, output: Option<PathBuf>, shown: usize) -> Result<(), Failure> {
-    let case =
-        Case::from_file(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+    let case = Case::from_file(path).map_err(|e| Failure::input(e.in_file(path)))?;
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

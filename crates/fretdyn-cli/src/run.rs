@@ -85,8 +85,7 @@ pub fn main(case: Option<&Path>, resume: Option<&Path>, options: &Options) -> Re
 }
 
 fn load(path: &Path) -> Result<Case, Failure> {
-    let case =
-        Case::from_file(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+    let case = Case::from_file(path).map_err(|e| Failure::input(e.in_file(path)))?;
     for w in &case.warnings {
         errln!("warning: {w}");
     }

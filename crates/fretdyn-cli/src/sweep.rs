@@ -18,8 +18,10 @@ pub fn main(
     jobs: usize,
     quiet: bool,
 ) -> Result<(), Failure> {
-    let s =
-        Study::from_file(study).map_err(|e| Failure::input(format!("{}: {e}", study.display())))?;
+    let s = Study::from_file(study).map_err(|e| Failure::input(e.in_file(study)))?;
+    // every run's case is built and checked before anything is run or written
+    s.check(jobs)
+        .map_err(|e| Failure::input(format!("{}; nothing was run", e.in_file(study))))?;
     let dir = output.unwrap_or_else(|| {
         let stem = study
             .file_stem()
@@ -57,8 +59,8 @@ pub fn main(
         }
     };
     let done = s
-        .execute(&table, jobs, &progress)
-        .map_err(|e| Failure::failed(format!("{}: {e}", study.display())))?;
+        .execute_checked(&table, jobs, &progress)
+        .map_err(|e| Failure::failed(e.in_file(study)))?;
     let wall = start.elapsed().as_secs_f64();
     if let Some(plot) = &s.plot {
         plot_table(&table, &plot.x, &plot.statistic, &dir.join("study.png"))?;

@@ -907,3 +907,292 @@ fn a_full_disk_while_packing_is_resumed_once_there_is_room() {
     assert!(remount.success());
     resumed_equals(&s.0, "disk/out", &s.0.join("full"));
 }
+
+// ---------------------------------------------------------------------------------------------
+// Bad input: refused with the field as the user wrote it, exit code 2, no hang
+// ---------------------------------------------------------------------------------------------
+
+const TUBE: &str = include_str!("../../../examples/tube_clamped_one_support.toml");
+
+/// Runs `fretdyn args` in `cwd`; fails the test if it has not finished after `seconds`.
+fn fretdyn_within(args: &[&str], cwd: &Path, seconds: u64) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args(args)
+        .current_dir(cwd)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("fretdyn runs");
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed().as_secs() >= seconds {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            panic!("fretdyn {args:?} did not finish in {seconds} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Writes `files` (the first is the case), runs it, and checks: done within a minute, exit
+/// code 2, one line on stderr naming the case file and containing every `needles`, nothing
+/// written.
+fn assert_refused(name: &str, files: &[(&str, &str)], needles: &[&str]) {
+    let s = Scratch::new(name);
+    for (file, text) in files {
+        std::fs::write(s.0.join(file), text).unwrap();
+    }
+    let out = fretdyn_within(&["run", files[0].0, "-o", "out"], &s.0, 60);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{name}: {stderr}");
+    assert_eq!(
+        stderr.trim_end().lines().count(),
+        1,
+        "{name}: not one line: {stderr}"
+    );
+    assert!(
+        stderr.starts_with(&format!("error: {}: ", files[0].0)),
+        "{name}: {stderr}"
+    );
+    for n in needles {
+        assert!(stderr.contains(n), "{name}: '{n}' not in: {stderr}");
+    }
+    assert!(!s.0.join("out").exists(), "{name}: output written");
+}
+
+#[test]
+fn a_duration_shorter_than_one_step_is_refused() {
+    let case = V1A.replace("duration = 4e-3", "duration = 1e-7");
+    assert_refused(
+        "short",
+        &[("case.toml", &case)],
+        &["time.duration", "shorter than one step", "duration ≥ dt"],
+    );
+}
+
+#[test]
+fn two_contacts_with_the_same_name_are_refused() {
+    let (start, end) = (
+        V1A.find("[[contacts]]").unwrap(),
+        V1A.find("[tangential]").unwrap(),
+    );
+    let case = format!("{}{}{}", &V1A[..end], &V1A[start..end], &V1A[end..]);
+    assert_refused(
+        "names",
+        &[("case.toml", &case)],
+        &["contacts[1].name", "'plane'", "unique"],
+    );
+}
+
+#[test]
+fn a_statistics_window_after_the_run_is_refused() {
+    let case = format!("{V1A}\n[statistics]\nt_start = 5e-3\n");
+    assert_refused(
+        "t_start",
+        &[("case.toml", &case)],
+        &[
+            "statistics.t_start",
+            "time.duration = 0.004",
+            "t_start < duration",
+        ],
+    );
+}
+
+/// It ran forever: 1e294 empty blocks per step.
+#[test]
+fn a_statistics_block_shorter_than_a_step_is_refused() {
+    let case = format!("{V1A}\n[statistics]\nblock = 1e-300\n");
+    assert_refused(
+        "block",
+        &[("case.toml", &case)],
+        &["statistics.block", "1e-300 s", "block ≥ dt"],
+    );
+}
+
+/// It ran forever: the eigen solver of the stability limit on an infinite stiffness term.
+#[test]
+fn a_mass_that_makes_the_stable_time_step_infinite_is_refused() {
+    let case = V1A.replace("mass = 1.0 ", "mass = 1e-320 ");
+    assert_refused(
+        "tiny_mass",
+        &[("case.toml", &case)],
+        &["contacts[0].normal", "1e-320 kg", "units"],
+    );
+}
+
+#[test]
+fn friction_and_initial_errors_name_the_key_written() {
+    let case = V1A.replace("friction = { mu = 0.3 }", "friction = { mu = -0.3 }");
+    assert_refused(
+        "mu",
+        &[("case.toml", &case)],
+        &["contacts[0].friction.mu:", "-0.3"],
+    );
+    let line = V1A.lines().find(|l| l.starts_with("velocity = ")).unwrap();
+    let case = V1A.replace(line, "velocity = [nan, 0.0, -1.0]");
+    assert_refused(
+        "velocity",
+        &[("case.toml", &case)],
+        &["initial.velocity:", "NaN"],
+    );
+}
+
+#[test]
+fn tube_errors_name_the_key_written() {
+    let case = TUBE.replace(
+        "damping_ratio = 0.01",
+        "rayleigh = { alpha = -500, beta = 0 }",
+    );
+    assert_refused(
+        "rayleigh",
+        &[("tube.toml", &case)],
+        &["structure.rayleigh.alpha", "-500"],
+    );
+    let case = TUBE.replace(
+        "friction = { mu = 0.3 }",
+        "friction = { mu = 0.3 }\nradius = 9.525",
+    );
+    assert_refused(
+        "radius",
+        &[("tube.toml", &case)],
+        &["contacts[0].radius", "outer radius 0.009525 m"],
+    );
+    let case = TUBE.replace("modes = 12", "modes = 100000");
+    assert_refused(
+        "modes",
+        &[("tube.toml", &case)],
+        &["structure.modes", "114 free DOFs", "modes ≤ 114"],
+    );
+}
+
+/// It aborted with "memory allocation failed".
+#[test]
+fn a_tube_too_large_for_memory_is_refused_with_the_figure() {
+    let case = TUBE.replace(
+        "path = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]",
+        "path = [[0.0, 0.0, 0.0], [1e9, 0.0, 0.0]]",
+    );
+    assert_refused(
+        "path",
+        &[("tube.toml", &case)],
+        &[
+            "structure.mesh_size",
+            "GB",
+            "use mesh_size ≥",
+            "units of path",
+        ],
+    );
+}
+
+#[test]
+fn a_bad_row_of_a_load_table_names_the_file_and_its_line() {
+    let case = V1A.replace(
+        "[tangential]\n",
+        "[[loads]]\npoint = \"mass\"\nforce = [0.0, 1.0, 0.0]\nhistory = { type = \"table\", file = \"load.csv\" }\n\n[tangential]\n",
+    );
+    assert_refused(
+        "load_csv",
+        &[
+            ("case.toml", &case),
+            ("load.csv", "t,value\n0,0\n1e-3,1\n5e-4,2\n"),
+        ],
+        &[
+            "loads[0].history.file",
+            "load.csv line 4:",
+            "strictly increasing",
+        ],
+    );
+}
+
+#[test]
+fn a_missing_file_is_named_once() {
+    let s = Scratch::new("once");
+    for command in ["run", "sweep", "modes"] {
+        let out = fretdyn(&[command, "nothere.toml"], &s.0);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{command}: {stderr}");
+        assert_eq!(
+            stderr.matches("nothere.toml").count(),
+            1,
+            "{command}: {stderr}"
+        );
+        assert!(stderr.contains("No such file"), "{command}: {stderr}");
+    }
+}
+
+#[test]
+fn a_study_file_given_to_run_says_to_use_sweep() {
+    let s = Scratch::new("study_run");
+    std::fs::write(s.0.join("case.toml"), V1A).unwrap();
+    std::fs::write(
+        s.0.join("study.toml"),
+        "base = \"case.toml\"\n\n[[parameters]]\nkey = \"time.dt\"\nvalues = [1e-6]\n",
+    )
+    .unwrap();
+    let out = fretdyn(&["run", "study.toml", "-o", "out"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("study file") && stderr.contains("fretdyn sweep"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("unknown field"), "{stderr}");
+}
+
+/// A value that makes one run invalid: exit 2 before any run, naming the run, its values and
+/// the field; nothing written.
+#[test]
+fn a_bad_study_value_is_refused_before_any_run() {
+    let s = Scratch::new("study_value");
+    std::fs::write(s.0.join("case.toml"), V1A).unwrap();
+    for (values, needles) in [
+        (
+            "[0.1, -0.3, 0.2]",
+            vec![
+                "run 1 (contacts.*.friction.mu = -0.3)",
+                "contacts[0].friction.mu:",
+                "nothing was run",
+            ],
+        ),
+        (
+            "[0.1, \"high\"]",
+            vec!["run 1 (", "parameters[0].values", "\"high\""],
+        ),
+    ] {
+        std::fs::write(
+            s.0.join("study.toml"),
+            format!(
+                "base = \"case.toml\"\n\n[[parameters]]\nkey = \"contacts.*.friction.mu\"\nvalues = {values}\n"
+            ),
+        )
+        .unwrap();
+        let out = fretdyn(&["sweep", "study.toml", "-o", "out", "-q"], &s.0);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+        assert!(stderr.starts_with("error: study.toml: "), "{stderr}");
+        for n in needles {
+            assert!(stderr.contains(n), "'{n}' not in: {stderr}");
+        }
+        assert!(!s.0.join("out").exists(), "a run was made");
+    }
+}
+
+#[test]
+fn study_syntax_errors_give_their_line_and_column() {
+    let s = Scratch::new("study_syntax");
+    std::fs::write(s.0.join("case.toml"), V1A).unwrap();
+    std::fs::write(
+        s.0.join("study.toml"),
+        "base = \"case.toml\"\n\n[[parameters]]\nkey = \"time.dt\"\nvalues = [1e-6 2e-6]\n",
+    )
+    .unwrap();
+    let out = fretdyn(&["sweep", "study.toml", "-o", "out"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.starts_with("error: study.toml: line 5, column 16: "),
+        "{stderr}"
+    );
+}

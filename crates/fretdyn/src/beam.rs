@@ -19,7 +19,7 @@
 
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, number};
 
 /// Circular tube section.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -157,6 +157,63 @@ impl Tube {
                 return Err(Error::invalid(
                     format!("{field}.{name}"),
                     format!("must be ≥ 0 (got {v})"),
+                ));
+            }
+        }
+        // the section's properties and the products the element matrices are made of must be
+        // numbers a computation can use: an extreme value (a unit slip) under- or overflows
+        let g = m.young_modulus / (2.0 * (1.0 + m.poisson_ratio));
+        for (v, what, name, unit) in [
+            (s.area(), "an area A", "outer_diameter", "m"),
+            (
+                s.second_moment(),
+                "a second moment I",
+                "outer_diameter",
+                "m",
+            ),
+            (
+                m.density * s.area(),
+                "a mass per length ρA",
+                "density",
+                "kg/m³",
+            ),
+            (
+                m.density * s.polar_moment(),
+                "a rotary inertia ρJ",
+                "density",
+                "kg/m³",
+            ),
+            (
+                self.mass_per_length(),
+                "a mass per length",
+                "density",
+                "kg/m³",
+            ),
+            (
+                m.young_modulus * s.area(),
+                "an axial stiffness EA",
+                "young_modulus",
+                "Pa",
+            ),
+            (
+                m.young_modulus * s.second_moment(),
+                "a bending stiffness EI",
+                "young_modulus",
+                "Pa",
+            ),
+            (
+                g * s.polar_moment(),
+                "a torsional stiffness GJ",
+                "young_modulus",
+                "Pa",
+            ),
+        ] {
+            if !v.is_normal() {
+                return Err(Error::invalid(
+                    format!("{field}.{name}"),
+                    format!(
+                        "gives the tube {what} of {v:e}, too extreme to compute with: check the units of {name} ({unit}) and of the other properties of the tube (outer_diameter and wall_thickness in m, density in kg/m³, young_modulus in Pa)"
+                    ),
                 ));
             }
         }
@@ -316,7 +373,8 @@ impl Mesh {
                 "needs at least two finite vertices [x, y, z]",
             ));
         }
-        let mut nodes = vec![vertices[0]];
+        let mut elements = 0.0;
+        let mut length = 0.0;
         for (k, w) in vertices.windows(2).enumerate() {
             let len = (w[1] - w[0]).norm();
             if !(len > 0.0) {
@@ -325,7 +383,20 @@ impl Mesh {
                     "repeats the previous vertex: segments must have a length",
                 ));
             }
-            let n = (len / mesh_size - 1e-9).ceil().max(1.0) as usize;
+            if !len.is_finite() {
+                return Err(Error::invalid(
+                    format!("structure.path[{}]", k + 1),
+                    "is too far from the previous vertex (the distance is not a finite number): check the units (m)",
+                ));
+            }
+            elements += segment_elements(len, mesh_size);
+            length += len;
+        }
+        check_mesh_size(elements, length, mesh_size, vertices.len() - 1, "path")?;
+        let mut nodes = vec![vertices[0]];
+        for w in vertices.windows(2) {
+            let len = (w[1] - w[0]).norm();
+            let n = segment_elements(len, mesh_size) as usize;
             for i in 1..=n {
                 nodes.push(w[0] + (w[1] - w[0]) * (i as f64 / n as f64));
             }
@@ -345,6 +416,15 @@ impl Mesh {
                 ));
             }
         }
+        let arc = std::f64::consts::PI * radius;
+        let arc_elements = segment_elements(arc, mesh_size).max(2.0);
+        check_mesh_size(
+            2.0 * segment_elements(leg_length, mesh_size) + arc_elements,
+            2.0 * leg_length + arc,
+            mesh_size,
+            3,
+            "u_bend",
+        )?;
         let leg = Self::polyline(
             &[
                 Vector3::new(-radius, 0.0, 0.0),
@@ -353,9 +433,7 @@ impl Mesh {
             mesh_size,
         )?;
         let mut nodes = leg.nodes;
-        let n_arc = (std::f64::consts::PI * radius / mesh_size - 1e-9)
-            .ceil()
-            .max(2.0) as usize;
+        let n_arc = arc_elements as usize;
         for i in 1..=n_arc {
             let a = std::f64::consts::PI * (1.0 - i as f64 / n_arc as f64);
             nodes.push(Vector3::new(
@@ -389,6 +467,78 @@ impl Mesh {
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap_or((0, f64::INFINITY))
     }
+}
+
+/// Elements of at most `mesh_size` on a segment of length `len`: `⌈len/mesh_size⌉` (at least 1).
+fn segment_elements(len: f64, mesh_size: f64) -> f64 {
+    (len / mesh_size - 1e-9).ceil().max(1.0)
+}
+
+/// Refuses, before anything is allocated, a mesh whose modal analysis would not fit in memory
+/// (`elements` of a tube `length` m long in `segments` straight pieces or arcs; `geometry`
+/// names the key that gives the length).
+fn check_mesh_size(
+    elements: f64,
+    length: f64,
+    mesh_size: f64,
+    segments: usize,
+    geometry: &str,
+) -> Result<()> {
+    let dofs = 6.0 * (elements + 1.0);
+    let (needed, available) = (modal_analysis_bytes(dofs), available_memory());
+    if needed <= available {
+        return Ok(());
+    }
+    // the largest mesh that fits: at most max_dofs/6 − 1 elements, plus one per segment
+    // for the rounding up of each segment
+    let max_elements = (max_dofs(available) / 6.0 - 1.0 - segments as f64).max(1.0);
+    Err(Error::invalid(
+        "structure.mesh_size",
+        format!(
+            "{} m on a tube {} m long gives {elements:.3e} elements ({dofs:.3e} DOFs): the dense matrices of its modal analysis would need {}, more than the {} of memory available; use mesh_size ≥ {:.3e} m, or check the units of {geometry} (m)",
+            number(mesh_size),
+            number(length),
+            gigabytes(needed),
+            gigabytes(available),
+            length / max_elements
+        ),
+    ))
+}
+
+/// Dense `n × n` matrices of `f64` alive at once at the peak of a tube's modal analysis
+/// ([`BeamModel::assemble`] then [`crate::eigen::lowest_modes`]): the reduced mass and
+/// stiffness, the Cholesky factor, the transformed matrix, the eigenvectors and the eigen
+/// solver's workspace: the peak resident memory of `fretdyn modes` on a 3 006-DOF tube is
+/// 7.6 × `8 n²` bytes; 9 leaves a margin.
+pub const DENSE_MATRICES_AT_PEAK: f64 = 9.0;
+
+/// Bytes the modal analysis of a tube of `dofs` degrees of freedom needs:
+/// `8 DENSE_MATRICES_AT_PEAK dofs²` (the matrices are dense).
+pub fn modal_analysis_bytes(dofs: f64) -> f64 {
+    8.0 * DENSE_MATRICES_AT_PEAK * dofs * dofs
+}
+
+/// The most DOFs whose modal analysis fits in `bytes`.
+fn max_dofs(bytes: f64) -> f64 {
+    (bytes / (8.0 * DENSE_MATRICES_AT_PEAK)).sqrt()
+}
+
+/// Memory available to a model, bytes: `MemAvailable` of `/proc/meminfo` (Linux), or 16 GiB
+/// where the system does not say.
+pub fn available_memory() -> f64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| {
+            let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+            let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+            Some(1024.0 * kib)
+        })
+        .unwrap_or(16.0 * 1024.0 * 1024.0 * 1024.0)
+}
+
+/// `bytes` as gigabytes, for messages.
+pub(crate) fn gigabytes(bytes: f64) -> String {
+    format!("{:.3e} GB", bytes / 1e9)
 }
 
 /// How a DOF is held.
@@ -441,6 +591,18 @@ impl BeamModel {
         self.tube.validate("structure")?;
         let nn = self.mesh.nodes.len();
         let n = 6 * nn;
+        let (needed, available) = (modal_analysis_bytes(n as f64), available_memory());
+        if needed > available {
+            return Err(Error::invalid(
+                "structure.mesh_size",
+                format!(
+                    "the mesh has {nn} nodes ({n} DOFs): the dense matrices of its modal analysis would need {}, more than the {} of memory available; use a coarser mesh (at most {:.0} nodes)",
+                    gigabytes(needed),
+                    gigabytes(available),
+                    max_dofs(available) / 6.0
+                ),
+            ));
+        }
         let mut k = DMatrix::<f64>::zeros(n, n);
         let mut m = DMatrix::<f64>::zeros(n, n);
         for (e, &[a, b]) in self.mesh.elements.iter().enumerate() {

@@ -11,7 +11,7 @@ use crate::beam::{
 };
 use crate::contact::{Contact, NormalLaw};
 use crate::eigen::ModeSelection;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, number};
 use crate::friction::{Coulomb, LocalSolve};
 use crate::load::{BaseAcceleration, ModalLoad, PointLoad, Sine, TimeHistory, TurbulentLoad};
 use crate::modal::{ModalBasis, PinnedBeam, Point};
@@ -20,6 +20,7 @@ use crate::motion::Motion;
 use crate::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
 use crate::simulation::RunSettings;
 use crate::spatial_correlation::{covariance_factor, line_covariance};
+use crate::stability::checked_stable_time_step;
 use crate::statistics::StatisticsSettings;
 use crate::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
@@ -61,8 +62,7 @@ impl Case {
 
     /// Parses a case from TOML text; `base` resolves relative file names.
     pub fn from_toml_str(text: &str, base: &Path) -> Result<Self> {
-        let file: CaseFile = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
-        let echo_value: toml::Value = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
+        let (echo_value, file) = read_case_file(text)?;
         let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
         let title = file.title.clone().unwrap_or_default();
         let mut warnings = Vec::new();
@@ -90,7 +90,27 @@ impl Case {
     }
 }
 
-fn parse_error(text: &str, e: &toml::de::Error) -> Error {
+/// Checks that `text` reads as a case file (TOML syntax, known keys, types), without building
+/// the case; errors give their line and column.
+pub(crate) fn check_case_text(text: &str) -> Result<()> {
+    read_case_file(text).map(|_| ())
+}
+
+/// The case file as TOML and as its schema.
+fn read_case_file(text: &str) -> Result<(toml::Value, CaseFile)> {
+    let value: toml::Value = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
+    if value.get("base").is_some() && value.get("structure").is_none() {
+        return Err(Error::invalid(
+            "base",
+            "this is a study file (a base case and parameters to vary), not a case file: run it with `fretdyn sweep <file>`",
+        ));
+    }
+    let file: CaseFile = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
+    Ok((value, file))
+}
+
+/// A TOML error with the line and column (from 1) where it is in `text`.
+pub(crate) fn parse_error(text: &str, e: &toml::de::Error) -> Error {
     let (line, column) = match e.span() {
         Some(span) => {
             let before = &text[..span.start.min(text.len())];
@@ -593,11 +613,18 @@ impl HistoryInput {
 }
 
 /// Rows `[t, value]` of a CSV (comma, semicolon or blank separated; `#` comments and a header
-/// line allowed) or a `.npy` (N × 2, float64) file.
+/// line allowed) or a `.npy` (N × 2, float64) file. A row that is not two finite numbers, a
+/// time that is not after the previous one, are errors naming the file and its line (the row
+/// of a `.npy`).
 fn read_table(path: &Path, field: &str) -> Result<Vec<[f64; 2]>> {
     let is_npy = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
+    let at = |place: String, message: String| {
+        Error::invalid(field, format!("{} {place}: {message}", path.display()))
+    };
+    // each row with where it is: "line n" of a CSV, "row n" of a .npy (from 1)
+    let mut rows: Vec<([f64; 2], String)> = Vec::new();
     if is_npy {
         let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
         let a: ndarray::Array2<f64> = ndarray_npy::ReadNpyExt::read_npy(file).map_err(|e| {
@@ -616,36 +643,69 @@ fn read_table(path: &Path, field: &str) -> Result<Vec<[f64; 2]>> {
                 ),
             ));
         }
-        return Ok(a.rows().into_iter().map(|r| [r[0], r[1]]).collect());
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let mut rows = Vec::new();
-    for (k, line) in text.lines().enumerate() {
-        let line = line.split('#').next().unwrap_or("").trim();
-        if line.is_empty() {
-            continue;
-        }
-        let cols: Vec<&str> = line
-            .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
-            .filter(|c| !c.is_empty())
-            .collect();
-        let parsed: Option<Vec<f64>> = cols.iter().map(|c| c.parse().ok()).collect();
-        match parsed {
-            Some(v) if v.len() == 2 => rows.push([v[0], v[1]]),
-            None if rows.is_empty() => continue, // a header line
-            _ => {
-                return Err(Error::invalid(
-                    field,
-                    format!(
-                        "{} line {}: expected two numbers t, value",
-                        path.display(),
-                        k + 1
-                    ),
-                ));
+        rows.extend(
+            a.rows()
+                .into_iter()
+                .enumerate()
+                .map(|(k, r)| ([r[0], r[1]], format!("row {}", k + 1))),
+        );
+    } else {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        for (k, line) in text.lines().enumerate() {
+            let line = line.split('#').next().unwrap_or("").trim();
+            if line.is_empty() {
+                continue;
+            }
+            let cols: Vec<&str> = line
+                .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
+                .filter(|c| !c.is_empty())
+                .collect();
+            let parsed: Option<Vec<f64>> = cols.iter().map(|c| c.parse().ok()).collect();
+            match parsed {
+                Some(v) if v.len() == 2 => rows.push(([v[0], v[1]], format!("line {}", k + 1))),
+                None if rows.is_empty() => continue, // a header line
+                _ => {
+                    return Err(at(
+                        format!("line {}", k + 1),
+                        format!("expected two numbers t, value (got '{line}')"),
+                    ));
+                }
             }
         }
     }
-    Ok(rows)
+    if rows.len() < 2 {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "{}: has {} row(s) of numbers: a table needs at least 2 rows t, value",
+                path.display(),
+                rows.len()
+            ),
+        ));
+    }
+    for (k, ([t, v], place)) in rows.iter().enumerate() {
+        if !(t.is_finite() && v.is_finite()) {
+            return Err(at(
+                place.clone(),
+                format!(
+                    "t = {}, value = {}: both must be finite numbers",
+                    number(*t),
+                    number(*v)
+                ),
+            ));
+        }
+        if k > 0 && *t <= rows[k - 1].0[0] {
+            return Err(at(
+                place.clone(),
+                format!(
+                    "t = {} s is not after the previous time {} s: times must be strictly increasing",
+                    number(*t),
+                    number(rows[k - 1].0[0])
+                ),
+            ));
+        }
+    }
+    Ok(rows.into_iter().map(|(r, _)| r).collect())
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -889,12 +949,28 @@ impl TubeInput {
             }
         };
         let damping = match (&self.damping_ratio, &self.rayleigh) {
-            (Some(DampingInput::Constant(x)), None) => Damping::Constant(*x),
+            (Some(DampingInput::Constant(x)), None) => {
+                check_damping_ratio(*x, "structure.damping_ratio")?;
+                Damping::Constant(*x)
+            }
             (Some(DampingInput::PerMode(v)), None) => Damping::PerMode(v.clone()),
-            (None, Some(r)) => Damping::Rayleigh {
-                alpha: r.alpha,
-                beta: r.beta,
-            },
+            (None, Some(r)) => {
+                for (v, key, unit) in [(r.alpha, "alpha", "1/s"), (r.beta, "beta", "s")] {
+                    if !(v.is_finite() && v >= 0.0) {
+                        return Err(Error::invalid(
+                            format!("structure.rayleigh.{key}"),
+                            format!(
+                                "must be a finite coefficient ≥ 0 in {unit} of C = αM + βK (got {})",
+                                number(v)
+                            ),
+                        ));
+                    }
+                }
+                Damping::Rayleigh {
+                    alpha: r.alpha,
+                    beta: r.beta,
+                }
+            }
             (None, None) => Damping::Constant(0.0),
             (Some(_), Some(_)) => {
                 return Err(Error::invalid(
@@ -913,6 +989,37 @@ impl TubeInput {
             selection,
             damping,
         })
+    }
+}
+
+/// Refuses, before they are allocated, more analytic modes than the memory holds: the rows
+/// of `points` points (3 per mode each) and the dense matrices of the stable time step.
+fn check_mode_count(modes: usize, points: usize) -> Result<()> {
+    let needed =
+        crate::stability::memory_bytes(modes) + 8.0 * 3.0 * modes as f64 * points.max(1) as f64;
+    let available = crate::beam::available_memory();
+    if needed > available {
+        return Err(Error::invalid(
+            "structure.modes_per_plane",
+            format!(
+                "gives {modes} modes, which would need {} of memory, more than the {} available: keep fewer modes",
+                crate::beam::gigabytes(needed),
+                crate::beam::gigabytes(available)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A damping ratio given as one number for every mode.
+fn check_damping_ratio(xi: f64, field: &str) -> Result<()> {
+    if xi.is_finite() && xi >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            field,
+            format!("must be a damping ratio ≥ 0, e.g. 0.01 for 1 % (got {xi})"),
+        ))
     }
 }
 
@@ -1046,13 +1153,43 @@ impl CaseFile {
                     ));
                 }
             };
-            let mut contact = Contact::new(
-                c.name.clone().unwrap_or_else(|| format!("contact{k}")),
-                pt,
-                obstacle,
-                normal,
-                Coulomb::new(mu_s, mu_d, &ff)?,
-            );
+            // errors name the key written: `mu` stands for both coefficients, and a lone
+            // `mu_static` (or `mu_dynamic`) for the other one too
+            let written = match (c.friction.mu, c.friction.mu_static, c.friction.mu_dynamic) {
+                (Some(_), _, _) => Some("mu"),
+                (None, Some(_), None) => Some("mu_static"),
+                (None, None, Some(_)) => Some("mu_dynamic"),
+                _ => None,
+            };
+            let friction = Coulomb::new(mu_s, mu_d, &ff).map_err(|e| match (e, written) {
+                (Error::Invalid { message, .. }, Some(key)) => {
+                    Error::invalid(format!("{ff}.{key}"), message)
+                }
+                (e, _) => e,
+            })?;
+            let name = c.name.clone().unwrap_or_else(|| format!("contact{k}"));
+            if let Some(j) = model.contacts.iter().position(|o| o.name == name) {
+                return Err(Error::invalid(
+                    format!("{field}.name"),
+                    format!(
+                        "'{name}' is already the name of contacts[{j}]: contact names must be unique (they label the outputs)"
+                    ),
+                ));
+            }
+            if let (Some(t), true) = (tube.as_deref(), c.radius > 0.0) {
+                let outer = 0.5 * t.structure.beam.tube.section.outer_diameter;
+                if c.radius > outer * (1.0 + 1e-9) {
+                    return Err(Error::invalid(
+                        format!("{field}.radius"),
+                        format!(
+                            "{} m is larger than the tube's outer radius {} m (structure.outer_diameter/2): give the outer radius in m",
+                            number(c.radius),
+                            number(outer)
+                        ),
+                    ));
+                }
+            }
+            let mut contact = Contact::new(name, pt, obstacle, normal, friction);
             contact.radius = c.radius;
             if let Some(m) = &c.motion {
                 contact.motion = m.motion();
@@ -1185,6 +1322,20 @@ impl CaseFile {
             match (&init.point, &init.q, &init.qdot) {
                 (Some(name), None, None) => {
                     let pt = point(name, "initial.point".into(), &model)?;
+                    for (key, v, unit) in [
+                        ("displacement", init.displacement, "m"),
+                        ("velocity", init.velocity, "m/s"),
+                    ] {
+                        if let Some(v) = v.filter(|v| v.iter().any(|x| !x.is_finite())) {
+                            return Err(Error::invalid(
+                                format!("initial.{key}"),
+                                format!(
+                                    "must be 3 finite numbers [x, y, z] in {unit} (got [{}, {}, {}])",
+                                    v[0], v[1], v[2]
+                                ),
+                            ));
+                        }
+                    }
                     model.set_initial_from_point(
                         pt,
                         v3(init.displacement.unwrap_or_default()),
@@ -1239,6 +1390,43 @@ impl CaseFile {
                 format!("must be a positive duration in s (got {duration})"),
             ));
         }
+        if duration < dt * (1.0 - 1e-9) {
+            return Err(Error::invalid(
+                "time.duration",
+                format!(
+                    "{} s is shorter than one step (time.dt = {} s): the run would do no step; set duration ≥ dt",
+                    number(duration),
+                    number(dt)
+                ),
+            ));
+        }
+        let statistics = &self.statistics;
+        // a step counts in the window when its middle is after t_start (THEORY §5): the last
+        // step's middle is half a step before the end
+        let last_middle = ((duration / dt).round() - 0.5) * dt;
+        if statistics.t_start >= last_middle {
+            return Err(Error::invalid(
+                "statistics.t_start",
+                format!(
+                    "{} s is not before the end of the run (time.duration = {} s): the statistics window would hold no step; set t_start < duration",
+                    number(statistics.t_start),
+                    number(duration)
+                ),
+            ));
+        }
+        if let Some(block) = statistics
+            .block
+            .filter(|b| *b > 0.0 && *b < dt * (1.0 - 1e-9))
+        {
+            return Err(Error::invalid(
+                "statistics.block",
+                format!(
+                    "{} s is shorter than one step (time.dt = {} s): a block holds whole steps; set block ≥ dt (e.g. a tenth of the window)",
+                    number(block),
+                    number(dt)
+                ),
+            ));
+        }
         let steps = (duration / dt).round();
         if steps > 1e12 {
             return Err(Error::invalid(
@@ -1264,6 +1452,20 @@ impl CaseFile {
             },
         };
         settings.validate()?;
+        // a model without a usable stable time step (a unit slip: a mass of 1e-320 kg, a
+        // radius of 1e200 m) is refused here, naming its cause; a Δt above a usable limit is
+        // left to the run, which says the limit
+        let stable_dt = checked_stable_time_step(&model, &settings.method)?;
+        if duration / stable_dt > 1e12 {
+            return Err(Error::invalid(
+                "time.dt",
+                format!(
+                    "the stable limit of central differences is {stable_dt:.3e} s (a highest frequency of about {:.3e} Hz, THEORY §2): {} s would take more than 1e12 steps; check the units of the structure (masses, densities, sizes, Young's modulus) and of the contact stiffnesses",
+                    2.0 / (std::f64::consts::TAU * stable_dt),
+                    number(duration)
+                ),
+            ));
+        }
         Ok((model, settings, tube))
     }
 }
@@ -1317,21 +1519,32 @@ impl StructureSection {
                 axial_modes,
                 damping_ratio,
                 points,
-            } => ModalBasis::pinned_beam(
-                &PinnedBeam {
-                    length: *length,
-                    bending_stiffness: *bending_stiffness,
-                    mass_per_length: *mass_per_length,
-                    modes_per_plane: *modes_per_plane,
-                    axial_stiffness: *axial_stiffness,
-                    axial_modes: *axial_modes,
-                    damping_ratio: *damping_ratio,
-                },
-                &points
-                    .iter()
-                    .map(|s| (s.name.clone(), s.x))
-                    .collect::<Vec<_>>(),
-            ),
+            } => check_damping_ratio(*damping_ratio, "structure.damping_ratio")
+                .and_then(|_| {
+                    check_mode_count(
+                        modes_per_plane
+                            .saturating_mul(2)
+                            .saturating_add(*axial_modes),
+                        points.len(),
+                    )
+                })
+                .and_then(|_| {
+                    ModalBasis::pinned_beam(
+                        &PinnedBeam {
+                            length: *length,
+                            bending_stiffness: *bending_stiffness,
+                            mass_per_length: *mass_per_length,
+                            modes_per_plane: *modes_per_plane,
+                            axial_stiffness: *axial_stiffness,
+                            axial_modes: *axial_modes,
+                            damping_ratio: *damping_ratio,
+                        },
+                        &points
+                            .iter()
+                            .map(|s| (s.name.clone(), s.x))
+                            .collect::<Vec<_>>(),
+                    )
+                }),
             StructureSection::Modal {
                 frequencies_hz,
                 damping_ratio,
@@ -1360,7 +1573,10 @@ impl StructureSection {
                 };
                 let p = basis.modes();
                 match damping_ratio {
-                    Some(DampingInput::Constant(x)) => basis.damping_ratio = vec![*x; p],
+                    Some(DampingInput::Constant(x)) => {
+                        check_damping_ratio(*x, "structure.damping_ratio")?;
+                        basis.damping_ratio = vec![*x; p]
+                    }
                     Some(DampingInput::PerMode(v)) => basis.damping_ratio = v.clone(),
                     None => {}
                 }

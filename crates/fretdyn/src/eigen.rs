@@ -70,29 +70,60 @@ pub fn lowest_modes(
             ));
         }
     }
-    let sigma = 1e-8
-        * (0..n)
-            .map(|i| stiffness[(i, i)].abs() / mass[(i, i)])
-            .fold(0.0, f64::max)
-            .max(f64::MIN_POSITIVE);
-    let shifted = Mat::<f64>::from_fn(n, n, |i, j| stiffness[(i, j)] + sigma * mass[(i, j)]);
-    let llt = shifted.llt(Side::Lower).map_err(|e| {
+    let ratio = (0..n)
+        .map(|i| stiffness[(i, i)].abs() / mass[(i, i)])
+        .fold(0.0, f64::max);
+    if !(ratio.is_finite() && ratio * n as f64 * 1e8 < f64::MAX) {
+        return Err(Error::invalid(
+            "structure",
+            format!(
+                "a stiffness over mass ratio K_ii/M_ii is {ratio:e} (an ω² of that size): the frequencies cannot be computed; check the units of the masses and stiffnesses"
+            ),
+        ));
+    }
+    let sigma = 1e-8 * ratio.max(f64::MIN_POSITIVE);
+    // the n × n matrices are dropped as soon as they are used: the memory at the peak is
+    // counted by `crate::beam::DENSE_MATRICES_AT_PEAK`
+    let llt = Mat::<f64>::from_fn(n, n, |i, j| stiffness[(i, j)] + sigma * mass[(i, j)])
+        .llt(Side::Lower)
+        .map_err(|e| {
+            Error::invalid(
+                "structure",
+                format!(
+                    "K + σM is not positive definite ({e:?}): the mass matrix is not positive definite, or the stiffness has a negative eigenvalue"
+                ),
+            )
+        })?;
+    let r = llt.L();
+    let mut b = {
+        let mut x = Mat::<f64>::from_fn(n, n, |i, j| mass[(i, j)]);
+        r.solve_lower_triangular_in_place(&mut x);
+        x.transpose().to_owned()
+    };
+    r.solve_lower_triangular_in_place(&mut b);
+    for j in 0..n {
+        for i in j + 1..n {
+            let v = 0.5 * (b[(i, j)] + b[(j, i)]);
+            b[(i, j)] = v;
+            b[(j, i)] = v;
+        }
+    }
+    // the eigen solver does not terminate on a term that is not a finite number
+    if (0..n).any(|j| (0..n).any(|i| !b[(i, j)].is_finite())) {
+        return Err(Error::invalid(
+            "structure",
+            "the mass and stiffness terms span too many orders of magnitude for the modal analysis (a term of R⁻¹ M R⁻ᵀ is not a finite number): check their units",
+        ));
+    }
+    let evd = b.self_adjoint_eigen(Side::Lower).map_err(|e| {
         Error::invalid(
             "structure",
             format!(
-                "K + σM is not positive definite ({e:?}): the mass matrix is not positive definite, or the stiffness has a negative eigenvalue"
+                "the eigen solver failed ({e:?}): the mass and stiffness terms may span too many orders of magnitude; check their units"
             ),
         )
     })?;
-    let r = llt.L();
-    let mut x = Mat::<f64>::from_fn(n, n, |i, j| mass[(i, j)]);
-    r.solve_lower_triangular_in_place(&mut x);
-    let mut b = x.transpose().to_owned();
-    r.solve_lower_triangular_in_place(&mut b);
-    let b = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (b[(i, j)] + b[(j, i)]));
-    let evd = b
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::invalid("structure", format!("the eigen solver failed: {e:?}")))?;
+    drop(b);
     let mu = evd.S().column_vector();
     // eigenvalues ascending: the lowest modes are the last ones
     let mut omega = Vec::new();

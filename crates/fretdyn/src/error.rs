@@ -43,6 +43,19 @@ pub enum Error {
     /// A `.npz` modal basis is missing a key or has an array of the wrong shape.
     #[error("{path}: {message}")]
     Npz { path: PathBuf, message: String },
+
+    /// One run of a study (a point of its grid or list) makes an invalid case: found before
+    /// any run starts.
+    #[error("run {index} ({point}): {source}")]
+    StudyRun {
+        /// Index of the run in the study.
+        index: usize,
+        /// Its parameter values and seed, as `key = value, …`.
+        point: String,
+        /// What is wrong with the case of this run.
+        #[source]
+        source: Box<Error>,
+    },
 }
 
 impl Error {
@@ -59,7 +72,17 @@ impl Error {
     pub fn field(&self) -> Option<&str> {
         match self {
             Error::Invalid { field, .. } => Some(field),
+            Error::StudyRun { source, .. } => source.field(),
             _ => None,
+        }
+    }
+
+    /// The one-line message of an error met while reading the file `path`: `path: error`,
+    /// without naming the file twice when the error is the file itself that cannot be read.
+    pub fn in_file(&self, path: &std::path::Path) -> String {
+        match self {
+            Error::Io { path: p, source } if p == path => format!("{}: {source}", p.display()),
+            other => format!("{}: {other}", path.display()),
         }
     }
 
@@ -73,3 +96,12 @@ impl Error {
 
 /// Result alias of the library.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// A number for a message, as a user would type it: `0.004`, `1e-7`, `2.5e12`.
+pub(crate) fn number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}

@@ -27,7 +27,7 @@ use std::time::Instant;
 
 use serde::Deserialize;
 
-use crate::case::Case;
+use crate::case::{Case, check_case_text, parse_error};
 use crate::error::{Error, Result};
 use crate::simulation::{RunResults, Simulation, Termination};
 
@@ -122,19 +122,25 @@ impl Study {
     /// Reads a study file.
     pub fn from_file(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let file: StudyFile = toml::from_str(&text).map_err(|e| Error::Parse {
-            line: 0,
-            column: 0,
-            message: e.message().trim().replace('\n', " "),
-        })?;
+        let value: toml::Value = toml::from_str(&text).map_err(|e| parse_error(&text, &e))?;
+        if value.get("base").is_none() && value.get("structure").is_some() {
+            return Err(Error::invalid(
+                "base",
+                "this is a case file, not a study file (base = \"case.toml\" and [[parameters]]): run it with `fretdyn run <file>`",
+            ));
+        }
+        let file: StudyFile = toml::from_str(&text).map_err(|e| parse_error(&text, &e))?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let base_path = dir.join(&file.base);
         let base_text =
             std::fs::read_to_string(&base_path).map_err(|e| Error::io(&base_path, e))?;
+        // the base case's own mistakes are reported with their line in it
+        check_case_text(&base_text)
+            .map_err(|e| Error::invalid("base", format!("{}: {e}", base_path.display())))?;
         let base: toml::Value = toml::from_str(&base_text).map_err(|e| {
             Error::invalid(
                 "base",
-                format!("{}: {}", base_path.display(), e.message().trim()),
+                format!("{}: {}", base_path.display(), parse_error(&base_text, &e)),
             )
         })?;
         let study = Self {
@@ -250,7 +256,33 @@ impl Study {
         }
         let text = toml::to_string(&value)
             .map_err(|e| Error::invalid("study", format!("cannot write the case: {e}")))?;
-        Case::from_toml_str(&text, &self.base_dir)
+        Case::from_toml_str(&text, &self.base_dir).map_err(|e| match e {
+            // the base reads (checked by `from_file`): a value does not fit its key
+            Error::Parse { message, .. } => self.misfit(run, message),
+            other => other,
+        })
+    }
+
+    /// The parameter whose value of `run` makes the case unreadable (a string where a number
+    /// is expected, an unknown method…): the first that does alone.
+    fn misfit(&self, run: &RunSpec, message: String) -> Error {
+        for (k, (p, v)) in self.parameters.iter().zip(&run.values).enumerate() {
+            let mut value = self.base.clone();
+            let alone = set_path(&mut value, &p.key, v)
+                .ok()
+                .and_then(|_| toml::to_string(&value).ok())
+                .is_some_and(|text| check_case_text(&text).is_err());
+            if alone {
+                return Error::invalid(
+                    format!("parameters[{k}].values"),
+                    format!("{} = {v} does not fit the case: {message}", p.key),
+                );
+            }
+        }
+        Error::invalid(
+            "parameters",
+            format!("these values do not fit the case: {message}"),
+        )
     }
 
     /// Names of the base case's contacts, as the case gives them (`contact<k>` when unnamed),
@@ -284,10 +316,66 @@ impl Study {
         cols.join(",")
     }
 
+    /// `key = value, …` of a run's parameters and its seed, for messages.
+    pub fn describe(&self, run: &RunSpec) -> String {
+        let mut parts: Vec<String> = self
+            .parameters
+            .iter()
+            .zip(&run.values)
+            .map(|(p, v)| format!("{} = {v}", p.key))
+            .collect();
+        if let Some(seed) = run.seed {
+            parts.push(format!("seed = {seed}"));
+        }
+        if parts.is_empty() {
+            "the base case".into()
+        } else {
+            parts.join(", ")
+        }
+    }
+
+    /// Builds the case of every run and checks it as a run would (the stability limit of
+    /// Δt included), `jobs` at a time (0: one per core), so that a value that makes a case
+    /// invalid is found before any run starts. The error is that of the first such run, as
+    /// [`Error::StudyRun`] naming it and its values.
+    pub fn check(&self, jobs: usize) -> Result<()> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(jobs)
+            .build()
+            .map_err(|e| Error::invalid("jobs", e.to_string()))?;
+        use rayon::prelude::*;
+        let runs = self.runs();
+        let first = pool.install(|| {
+            runs.par_iter().find_map_first(|run| {
+                self.case(run)
+                    .and_then(|case| Simulation::check(&case.model, &case.settings))
+                    .err()
+                    .map(|e| Error::StudyRun {
+                        index: run.index,
+                        point: self.describe(run),
+                        source: Box::new(e),
+                    })
+            })
+        });
+        first.map_or(Ok(()), Err)
+    }
+
     /// Runs every run not already in the table at `table` (created with its header if
     /// missing), `jobs` at a time (0: one per core), appending one row per run as it
     /// finishes; `progress(done, total)` after each. Returns the number of runs done now.
+    /// Every run is checked first ([`Self::check`]): a bad value runs nothing.
     pub fn execute(
+        &self,
+        table: &Path,
+        jobs: usize,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<usize> {
+        self.check(jobs)?;
+        self.execute_checked(table, jobs, progress)
+    }
+
+    /// [`Self::execute`] after [`Self::check`] passed: the runs are not checked again.
+    pub fn execute_checked(
         &self,
         table: &Path,
         jobs: usize,

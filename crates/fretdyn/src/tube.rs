@@ -66,7 +66,27 @@ impl TubeStructure {
     /// Assembles, computes the modes and extracts the rows of the named points.
     pub fn modal_basis(&self) -> Result<TubeBasis> {
         let assembled = self.beam.assemble()?;
-        let modes = lowest_modes(&assembled.mass, &assembled.stiffness, self.selection)?;
+        let n = assembled.mass.nrows();
+        if let ModeSelection::Count(count) = self.selection {
+            if count > n {
+                return Err(Error::invalid(
+                    "structure.modes",
+                    format!(
+                        "{count} modes asked, but the tube has {n} free DOFs, hence {n} modes: set modes ≤ {n} (all of them), or refine mesh_size for more"
+                    ),
+                ));
+            }
+        }
+        let modes = lowest_modes(&assembled.mass, &assembled.stiffness, self.selection)
+            .map_err(|e| match e {
+                Error::Invalid { field, message } if field == "structure" => Error::invalid(
+                    field,
+                    format!(
+                        "{message} (the tube's outer_diameter and wall_thickness are in m, density in kg/m³, young_modulus in Pa)"
+                    ),
+                ),
+                other => other,
+            })?;
         let p = modes.omega.len();
         let damping_ratio = match &self.damping {
             Damping::Constant(x) => vec![*x; p],
@@ -82,17 +102,31 @@ impl TubeStructure {
                 }
                 v[..p].to_vec()
             }
-            Damping::Rayleigh { alpha, beta } => modes
-                .omega
-                .iter()
-                .map(|w| {
-                    if *w > 0.0 {
-                        0.5 * (alpha / w + beta * w)
-                    } else {
-                        0.0
-                    }
-                })
-                .collect(),
+            Damping::Rayleigh { alpha, beta } => {
+                let ratios: Vec<f64> = modes
+                    .omega
+                    .iter()
+                    .map(|w| {
+                        if *w > 0.0 {
+                            0.5 * (alpha / w + beta * w)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                if let Some(i) = ratios.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
+                    return Err(Error::invalid(
+                        "structure.rayleigh",
+                        format!(
+                            "α = {alpha}, β = {beta} give mode {} (ω = {:e} rad/s) the damping ratio ξ = α/(2ω) + βω/2 = {}: give α ≥ 0 in 1/s and β ≥ 0 in s that make it a finite number",
+                            i + 1,
+                            modes.omega[i],
+                            ratios[i]
+                        ),
+                    ));
+                }
+                ratios
+            }
         };
         let points = self.named_points(&assembled, &modes.shapes);
         Ok(TubeBasis {

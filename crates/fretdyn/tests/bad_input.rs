@@ -1,0 +1,588 @@
+//! Bad input is refused before a run, never with a panic, a hang or an abort: each error names
+//! the field as the user wrote it (`contacts[0].friction.mu`, not the coefficient it stands
+//! for) and says how to fix it. Models that would not fit in memory are refused with the
+//! figure before anything is allocated.
+
+use std::path::{Path, PathBuf};
+
+use fretdyn::Error;
+use fretdyn::case::Case;
+use fretdyn::contact::{Contact, NormalLaw};
+use fretdyn::friction::Coulomb;
+use fretdyn::modal::ModalBasis;
+use fretdyn::model::Model;
+use fretdyn::obstacle::{Obstacle, Plane};
+use fretdyn::stability::{checked_stable_time_step, stable_time_step};
+use fretdyn::study::Study;
+use fretdyn::tangential::{GaussSeidelSettings, TangentialMethod};
+use nalgebra::Vector3;
+
+const V1A: &str = include_str!("../../../examples/v1a_oblique_impact.toml");
+const TUBE: &str = include_str!("../../../examples/tube_clamped_one_support.toml");
+
+fn replace_once(text: &str, from: &str, to: &str) -> String {
+    assert_eq!(text.matches(from).count(), 1, "'{from}' should occur once");
+    text.replacen(from, to, 1)
+}
+
+/// The field and message of the `Error::Invalid` that `text` gives (files relative to `base`).
+fn invalid_in(text: &str, base: &Path) -> (String, String) {
+    match Case::from_toml_str(text, base) {
+        Err(Error::Invalid { field, message }) => (field, message),
+        Err(e) => panic!("expected Error::Invalid, got {e:?}"),
+        Ok(_) => panic!("expected an error"),
+    }
+}
+
+fn invalid(text: &str) -> (String, String) {
+    invalid_in(text, Path::new("."))
+}
+
+/// A fresh scratch folder, removed at the end.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let dir =
+            std::env::temp_dir().join(format!("fretdyn-bad-input-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Time and statistics
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn a_duration_shorter_than_one_step_is_refused() {
+    let text = replace_once(V1A, "duration = 4e-3", "duration = 4e-7");
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "time.duration");
+    assert!(
+        message.contains("shorter than one step") && message.contains("duration ≥ dt"),
+        "{message}"
+    );
+    // one step is a run
+    let text = replace_once(V1A, "duration = 4e-3", "duration = 1e-6");
+    assert_eq!(
+        Case::from_toml_str(&text, Path::new("."))
+            .unwrap()
+            .settings
+            .steps,
+        1
+    );
+}
+
+#[test]
+fn a_statistics_window_after_the_run_is_refused() {
+    // 3.99975e-3: after the middle of the last step, 3.9995e-3
+    for t_start in ["4e-3", "5e-3", "3.99975e-3"] {
+        let text = format!("{V1A}\n[statistics]\nt_start = {t_start}\n");
+        let (field, message) = invalid(&text);
+        assert_eq!(field, "statistics.t_start");
+        assert!(
+            message.contains("time.duration = 0.004") && message.contains("t_start < duration"),
+            "{message}"
+        );
+    }
+}
+
+/// A block shorter than a step closed thousands of empty blocks per step (forever, for a block
+/// of 1e-300 s).
+#[test]
+fn a_statistics_block_shorter_than_a_step_is_refused() {
+    for block in ["1e-9", "1e-300"] {
+        let text = format!("{V1A}\n[statistics]\nblock = {block}\n");
+        let (field, message) = invalid(&text);
+        assert_eq!(field, "statistics.block");
+        assert!(
+            message.contains("shorter than one step") && message.contains("block ≥ dt"),
+            "{message}"
+        );
+    }
+    let text = format!("{V1A}\n[statistics]\nblock = 1e-6\n");
+    assert!(Case::from_toml_str(&text, Path::new(".")).is_ok());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Contacts, friction, initial state, damping: the field as written
+// ---------------------------------------------------------------------------------------------
+
+fn with_second_contact(name_line: &str) -> String {
+    let start = V1A.find("[[contacts]]").unwrap();
+    let end = V1A.find("[tangential]").unwrap();
+    let second = V1A[start..end].replace("name = \"plane\"", name_line);
+    format!("{}{second}{}", &V1A[..end], &V1A[end..])
+}
+
+#[test]
+fn two_contacts_with_the_same_name_are_refused() {
+    let (field, message) = invalid(&with_second_contact("name = \"plane\""));
+    assert_eq!(field, "contacts[1].name");
+    assert!(
+        message.contains("'plane'") && message.contains("contacts[0]"),
+        "{message}"
+    );
+    // an unnamed contact is contact<k>: a user name may not take it
+    let text = with_second_contact("");
+    let text = replace_once(&text, "name = \"plane\"", "name = \"contact1\"");
+    let (field, _) = invalid(&text);
+    assert_eq!(field, "contacts[1].name");
+    // distinct names are fine
+    assert!(Case::from_toml_str(&with_second_contact("name = \"other\""), Path::new(".")).is_ok());
+}
+
+#[test]
+fn friction_errors_name_the_key_written() {
+    let text = replace_once(V1A, "friction = { mu = 0.3 }", "friction = { mu = -0.3 }");
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "contacts[0].friction.mu");
+    assert!(message.contains("-0.3"), "{message}");
+    let text = replace_once(
+        V1A,
+        "friction = { mu = 0.3 }",
+        "friction = { mu_static = nan }",
+    );
+    assert_eq!(invalid(&text).0, "contacts[0].friction.mu_static");
+    let text = replace_once(
+        V1A,
+        "friction = { mu = 0.3 }",
+        "friction = { mu_static = 0.2, mu_dynamic = -1 }",
+    );
+    assert_eq!(invalid(&text).0, "contacts[0].friction.mu_dynamic");
+}
+
+#[test]
+fn a_non_finite_initial_velocity_is_named_as_written() {
+    let line = V1A.lines().find(|l| l.starts_with("velocity = ")).unwrap();
+    let text = replace_once(V1A, line, "velocity = [nan, 0.0, -1.0]");
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "initial.velocity");
+    assert!(
+        message.contains("NaN") && message.contains("m/s"),
+        "{message}"
+    );
+    let text = replace_once(
+        V1A,
+        "displacement = [0.0, 0.0, 0.0]",
+        "displacement = [0.0, inf, 0.0]",
+    );
+    assert_eq!(invalid(&text).0, "initial.displacement");
+}
+
+#[test]
+fn rayleigh_coefficients_are_named_as_written() {
+    let text = replace_once(
+        TUBE,
+        "damping_ratio = 0.01",
+        "rayleigh = { alpha = -500, beta = 0 }",
+    );
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "structure.rayleigh.alpha");
+    assert!(message.contains("-500"), "{message}");
+    let text = replace_once(
+        TUBE,
+        "damping_ratio = 0.01",
+        "rayleigh = { alpha = 0, beta = -1e-5 }",
+    );
+    assert_eq!(invalid(&text).0, "structure.rayleigh.beta");
+    // one damping ratio for every mode is one field, not one per mode
+    let text = replace_once(TUBE, "damping_ratio = 0.01", "damping_ratio = -0.01");
+    assert_eq!(invalid(&text).0, "structure.damping_ratio");
+}
+
+/// A contact radius in mm (9.525 for 9.525e-3 m) on a tube of 19.05 mm.
+#[test]
+fn a_contact_radius_larger_than_the_tube_is_refused() {
+    let text = replace_once(
+        TUBE,
+        "friction = { mu = 0.3 }",
+        "friction = { mu = 0.3 }\nradius = 9.525",
+    );
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "contacts[0].radius");
+    assert!(
+        message.contains("9.525 m") && message.contains("0.009525 m"),
+        "{message}"
+    );
+    // the outer radius itself is the radius of a contact on the surface
+    let text = replace_once(
+        TUBE,
+        "friction = { mu = 0.3 }",
+        "friction = { mu = 0.3 }\nradius = 9.525e-3",
+    );
+    let text = replace_once(&text, "offset = [0.0, -9.525e-3, 0.0]", "");
+    let text = replace_once(
+        &text,
+        "origin = [0.5, -9.525e-3, 0.0]",
+        "origin = [0.5, 0.0, 0.0]",
+    );
+    let case = Case::from_toml_str(&text, Path::new(".")).unwrap();
+    assert_eq!(case.model.contacts[0].radius, 9.525e-3);
+}
+
+#[test]
+fn a_bad_row_of_a_load_table_names_the_file_and_its_line() {
+    let dir = TempDir::new("load_csv");
+    let text = replace_once(
+        V1A,
+        "[tangential]\n",
+        "[[loads]]\npoint = \"mass\"\nforce = [0.0, 1.0, 0.0]\nhistory = { type = \"table\", file = \"load.csv\" }\n\n[tangential]\n",
+    );
+    // line 4 goes back in time, line 3 is not finite, line 5 is not two numbers
+    for (csv, line, needle) in [
+        ("t,value\n0,0\n1e-3,1\n5e-4,2\n", 4, "strictly increasing"),
+        ("# a comment\n0,0\n1e-3,nan\n2e-3,1\n", 3, "finite"),
+        ("t,value\n0,0\n1e-3,1\n\n2e-3\n", 5, "two numbers"),
+    ] {
+        std::fs::write(dir.0.join("load.csv"), csv).unwrap();
+        let (field, message) = invalid_in(&text, &dir.0);
+        assert_eq!(field, "loads[0].history.file");
+        assert!(
+            message.contains(&format!("load.csv line {line}:")) && message.contains(needle),
+            "{message}"
+        );
+    }
+    std::fs::write(dir.0.join("load.csv"), "t,value\n0,0\n1e-3,1\n").unwrap();
+    assert!(Case::from_toml_str(&text, &dir.0).is_ok());
+}
+
+#[test]
+fn a_study_file_is_not_a_case() {
+    let text = "base = \"v1a.toml\"\n[[parameters]]\nkey = \"time.dt\"\nvalues = [1e-6]\n";
+    let (field, message) = invalid(text);
+    assert_eq!(field, "base");
+    assert!(
+        message.contains("study file") && message.contains("fretdyn sweep"),
+        "{message}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Extreme values: no hang, no abort
+// ---------------------------------------------------------------------------------------------
+
+/// A point mass of 1e-320 kg on a 1e6 N/m contact: K_N/m is not a finite number; the eigen
+/// solver of the stability limit looped forever on it.
+#[test]
+fn a_mass_that_makes_the_stable_time_step_infinite_is_refused() {
+    let text = replace_once(V1A, "mass = 1.0 ", "mass = 1e-320 ");
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "contacts[0].normal");
+    assert!(
+        message.contains("1e-320 kg") && message.contains("not a finite number"),
+        "{message}"
+    );
+
+    // the same model built in code: no stable time step, so every Δt is refused
+    let mut model = Model::new(ModalBasis::point_mass(1e-320, "mass", Vector3::zeros()).unwrap());
+    model.contacts.push(Contact::new(
+        "plane",
+        0,
+        Obstacle::Plane(Plane::new(Vector3::zeros(), Vector3::z(), 0.0, None, "p").unwrap()),
+        NormalLaw::new(1e6, 0.0, "n").unwrap(),
+        Coulomb::new(0.3, 0.3, "f").unwrap(),
+    ));
+    let gs = TangentialMethod::GaussSeidel(GaussSeidelSettings::default());
+    assert!(checked_stable_time_step(&model, &gs).is_err());
+    assert_eq!(stable_time_step(&model, &gs), 0.0);
+}
+
+/// A contact on the surface of a modal structure with rotations, at a radius of 1e200 m: the
+/// Delassus operator was not finite and the run looped forever.
+#[test]
+fn a_contact_radius_that_makes_the_contact_rows_infinite_is_refused() {
+    let inline = include_str!("../../../examples/v1a_modal_inline.toml");
+    let rows_end = "  [0.0, 0.0, 1.0],                  # z\n]\n";
+    let text = replace_once(
+        inline,
+        rows_end,
+        &format!("{rows_end}rotations = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]\n"),
+    );
+    let text = replace_once(
+        &text,
+        "friction = { mu = 0.3 }",
+        "friction = { mu = 0.3 }\nradius = 1e200",
+    );
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "contacts[0].radius");
+    assert!(message.contains("1e200 m"), "{message}");
+    assert!(
+        Case::from_toml_str(
+            &text.replace("radius = 1e200", "radius = 0.01"),
+            Path::new(".")
+        )
+        .is_ok()
+    );
+}
+
+/// A mass of 1e-300 kg has a stable time step (2e-153 s), but no run can take 1e150 steps.
+#[test]
+fn a_mass_that_makes_the_run_endless_is_refused() {
+    let text = replace_once(V1A, "mass = 1.0 ", "mass = 1e-300 ");
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "time.dt");
+    // 2/ω with ω = √(K_N/m) = 1e153 rad/s
+    assert!(
+        message.contains("2.000e-153 s") && message.contains("1e12 steps"),
+        "{message}"
+    );
+}
+
+/// With heavy contact damping the limit is (2/ω)(√(1+ζ²) − ζ) → 1/(ζω) = 2/c, c = C_N/m: it
+/// was computed as 0 (cancellation) for ζ > 1e8.
+#[test]
+fn the_stable_time_step_with_heavy_damping_is_two_over_the_damping_rate() {
+    let (m, kn, cn) = (1.0, 1e6, 1e12);
+    let mut model = Model::new(ModalBasis::point_mass(m, "mass", Vector3::zeros()).unwrap());
+    model.contacts.push(Contact::new(
+        "plane",
+        0,
+        Obstacle::Plane(Plane::new(Vector3::zeros(), Vector3::z(), 0.0, None, "p").unwrap()),
+        NormalLaw::new(kn, cn, "n").unwrap(),
+        Coulomb::new(0.3, 0.3, "f").unwrap(),
+    ));
+    let gs = TangentialMethod::GaussSeidel(GaussSeidelSettings::default());
+    let dt = checked_stable_time_step(&model, &gs).unwrap();
+    // ζ = 5e8: the next term of the expansion, 1/(4ζ²), is 1e-18
+    let expected = 2.0 / (cn / m);
+    assert!(
+        (dt - expected).abs() <= 1e-12 * expected,
+        "{dt} vs {expected}"
+    );
+}
+
+#[test]
+fn a_tube_diameter_too_small_to_compute_with_is_refused() {
+    for (d, t) in [("1e-100", "1e-101"), ("1e-80", "1e-81")] {
+        let text = replace_once(
+            TUBE,
+            "outer_diameter = 19.05e-3",
+            &format!("outer_diameter = {d}"),
+        );
+        let text = replace_once(
+            &text,
+            "wall_thickness = 1.09e-3",
+            &format!("wall_thickness = {t}"),
+        );
+        let (field, message) = invalid(&text);
+        assert_eq!(field, "structure.outer_diameter", "{message}");
+        assert!(message.contains("units"), "{message}");
+    }
+    // a Young's modulus and a density of opposite extremes
+    let text = replace_once(TUBE, "young_modulus = 2.0e11", "young_modulus = 1e-300");
+    let text = replace_once(&text, "density = 8200.0", "density = 1e300");
+    assert_eq!(invalid(&text).0, "structure.young_modulus");
+}
+
+/// A path of 1e9 m (a unit slip) and a mesh of 1e6 elements aborted with "memory allocation
+/// failed": the memory the dense modal analysis needs is refused with its figure.
+#[test]
+fn a_tube_mesh_too_large_for_memory_is_refused_with_the_figure() {
+    let long = replace_once(
+        TUBE,
+        "path = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]",
+        "path = [[0.0, 0.0, 0.0], [1e9, 0.0, 0.0]]",
+    );
+    let fine = replace_once(TUBE, "mesh_size = 0.05 ", "mesh_size = 1e-6 ");
+    for (text, elements) in [(long, "2.000e10 elements"), (fine, "1.000e6 elements")] {
+        let (field, message) = invalid(&text);
+        assert_eq!(field, "structure.mesh_size");
+        assert!(
+            message.contains(elements)
+                && message.contains("GB")
+                && message.contains("use mesh_size ≥")
+                && message.contains("units of path"),
+            "{message}"
+        );
+        // the figure: 6 DOFs per node, dense n × n matrices of 8 bytes
+        let nodes: f64 = elements.split(' ').next().unwrap().parse::<f64>().unwrap() + 1.0;
+        let gb = 8.0 * (6.0 * nodes).powi(2) / 1e9;
+        let needed: f64 = message
+            .split("would need ")
+            .nth(1)
+            .and_then(|r| r.split(' ').next())
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(needed >= gb, "{needed} GB for {gb} GB of one matrix");
+    }
+    let u_bend = replace_once(
+        TUBE,
+        "path = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]",
+        "u_bend = { leg_length = 1.0, radius = 1e12 }",
+    );
+    let (field, message) = invalid(&u_bend);
+    assert_eq!(field, "structure.mesh_size");
+    assert!(message.contains("units of u_bend"), "{message}");
+}
+
+/// `modes = 100000` on a tube of 114 free DOFs was cut to 114 silently.
+#[test]
+fn more_modes_than_the_tube_has_are_refused() {
+    let text = replace_once(TUBE, "modes = 12", "modes = 100000");
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "structure.modes");
+    assert!(
+        message.contains("114 free DOFs") && message.contains("modes ≤ 114"),
+        "{message}"
+    );
+    let text = replace_once(TUBE, "modes = 12", "modes = 114");
+    assert_eq!(
+        Case::from_toml_str(&text, Path::new("."))
+            .unwrap()
+            .model
+            .basis
+            .modes(),
+        114
+    );
+}
+
+#[test]
+fn an_analytic_beam_with_more_modes_than_memory_is_refused() {
+    let text = r#"
+[time]
+dt = 1e-6
+duration = 1e-3
+
+[structure]
+type = "pinned_beam"
+length = 1.0
+bending_stiffness = 1e3
+mass_per_length = 1.0
+modes_per_plane = 1000000000
+points = [{ name = "mid", x = 0.5 }]
+"#;
+    let (field, message) = invalid(text);
+    assert_eq!(field, "structure.modes_per_plane");
+    assert!(message.contains("GB"), "{message}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Studies
+// ---------------------------------------------------------------------------------------------
+
+fn study_dir(name: &str, study: &str) -> (TempDir, PathBuf) {
+    let dir = TempDir::new(name);
+    std::fs::write(dir.0.join("v1a.toml"), V1A).unwrap();
+    let path = dir.0.join("study.toml");
+    std::fs::write(&path, study).unwrap();
+    (dir, path)
+}
+
+/// A value that makes one run's case invalid is found before any run, naming the run, its
+/// values and the field; nothing is written.
+#[test]
+fn a_study_value_that_makes_a_case_invalid_is_refused_before_any_run() {
+    let (dir, path) = study_dir(
+        "study_value",
+        "base = \"v1a.toml\"\n\n[[parameters]]\nkey = \"contacts.*.friction.mu\"\nvalues = [0.1, -0.3]\n\n[[parameters]]\nkey = \"time.dt\"\nvalues = [1e-6, 2e-6]\n",
+    );
+    let study = Study::from_file(&path).unwrap();
+    let err = study.check(1).unwrap_err();
+    let Error::StudyRun {
+        index,
+        point,
+        source,
+    } = &err
+    else {
+        panic!("expected StudyRun, got {err:?}");
+    };
+    // grid order: mu varies slowest
+    assert_eq!(*index, 2);
+    assert!(
+        point.contains("contacts.*.friction.mu = -0.3") && point.contains("time.dt"),
+        "{point}"
+    );
+    assert_eq!(source.field(), Some("contacts[0].friction.mu"));
+    assert!(err.to_string().starts_with("run 2 ("), "{err}");
+    let table = dir.0.join("study.csv");
+    assert!(study.execute(&table, 1, &|_, _| {}).is_err());
+    assert!(!table.exists(), "a run was made");
+
+    // a Δt above the stable limit (ω = 1000 rad/s: 2 ms) is a bad value too
+    let (_dir, path) = study_dir(
+        "study_dt",
+        "base = \"v1a.toml\"\n\n[[parameters]]\nkey = \"time.dt\"\nvalues = [1e-6, 3e-3]\n",
+    );
+    let err = Study::from_file(&path).unwrap().check(0).unwrap_err();
+    assert!(matches!(&err, Error::StudyRun { index: 1, .. }), "{err}");
+    assert!(err.to_string().contains("stable limit"), "{err}");
+
+    // a value of the wrong kind names the parameter, not a line of a generated file
+    let (_dir, path) = study_dir(
+        "study_method",
+        "base = \"v1a.toml\"\n\n[[parameters]]\nkey = \"tangential.method\"\nvalues = [\"gauss_seidel\", \"newton\"]\n",
+    );
+    let err = Study::from_file(&path).unwrap().check(0).unwrap_err();
+    assert_eq!(err.field(), Some("parameters[0].values"), "{err}");
+    assert!(
+        err.to_string().contains("newton") && !err.to_string().contains("line "),
+        "{err}"
+    );
+}
+
+#[test]
+fn study_syntax_errors_give_their_line_and_column() {
+    let (_dir, path) = study_dir(
+        "study_syntax",
+        "base = \"v1a.toml\"\n\n[[parameters]]\nkey = \"time.dt\"\nvalues = [1e-6 2e-6]\n",
+    );
+    match Study::from_file(&path) {
+        Err(Error::Parse { line, column, .. }) => assert_eq!((line, column), (5, 16)),
+        other => panic!("expected a parse error, got {other:?}"),
+    }
+    let (_dir, path) = study_dir(
+        "study_key",
+        "base = \"v1a.toml\"\n\n[[parameters]]\nkey = \"time.dt\"\nvalues = [1e-6]\nvalue = 2\n",
+    );
+    match Study::from_file(&path) {
+        Err(Error::Parse { line, message, .. }) => {
+            assert_eq!(line, 6);
+            assert!(message.contains("value"), "{message}");
+        }
+        other => panic!("expected a parse error, got {other:?}"),
+    }
+    // a mistake in the base case: its own line
+    let (dir, path) = study_dir("study_base", "base = \"v1a.toml\"\n");
+    std::fs::write(
+        dir.0.join("v1a.toml"),
+        replace_once(V1A, "duration = 4e-3", "duration = 4e-3\nsteps = 3"),
+    )
+    .unwrap();
+    let line = V1A.lines().position(|l| l.starts_with("duration")).unwrap() + 2;
+    let err = Study::from_file(&path).unwrap_err();
+    assert_eq!(err.field(), Some("base"));
+    assert!(
+        err.to_string()
+            .contains(&format!("v1a.toml: line {line}, column 1")),
+        "{err}"
+    );
+    // a case given as a study
+    let (_dir, path) = study_dir("study_case", V1A);
+    let err = Study::from_file(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("case file") && err.contains("fretdyn run"),
+        "{err}"
+    );
+}
+
+/// A missing file is named once.
+#[test]
+fn a_missing_file_is_named_once() {
+    let path = Path::new("no_such_case.toml");
+    let err = Case::from_file(path).unwrap_err();
+    let message = err.in_file(path);
+    assert_eq!(message.matches("no_such_case.toml").count(), 1, "{message}");
+    // another file in the message is still named
+    let err = Error::invalid("structure", "x");
+    assert_eq!(err.in_file(path), "no_such_case.toml: structure: x");
+}
