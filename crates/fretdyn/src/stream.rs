@@ -77,7 +77,7 @@ pub const IMPACTS_FILE: &str = "impacts.csv";
 pub const BLOCKS_FILE: &str = "blocks.csv";
 pub const RESULTS_FILE: &str = "results.npz";
 
-const CHECKPOINT_VERSION: u32 = 1;
+const CHECKPOINT_VERSION: u32 = 2;
 
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {
