@@ -2,7 +2,11 @@
 //! seismic motion, a bar that slides (THEORY §3, "obstacles may move").
 //!
 //! The obstacle is translated rigidly by `d(t)`: its geometry is evaluated at `x − d(t)` and
-//! its surface moves with `ḋ(t)`, the `v_imp` of the stick constraint (THEORY §2, §4.2).
+//! its surface moves with `ḋ(t)`. The time loop uses the velocities of its discrete motion,
+//! consistent with central differences: the step velocity `(d(t_{n+2}) − d(t_{n+1}))/Δt` is
+//! the `v_imp` of the stick constraint on the half-step velocity, and the mean of two step
+//! velocities the full-step velocity the slip is measured against (THEORY §2, §4.2, §5;
+//! [`Motion::step_velocity`], [`Motion::full_step_velocity`]).
 
 use nalgebra::Vector3;
 
@@ -102,6 +106,38 @@ impl Motion {
     #[inline]
     pub fn is_fixed(&self) -> bool {
         matches!(self, Motion::Fixed)
+    }
+
+    /// Velocity that carries a point with the obstacle from step `k` to step `k + 1`:
+    /// `(d(t_{k+1}) − d(t_k))/Δt` with `t_k = kΔt` computed as the time loop computes it, so
+    /// that the imposed velocities of successive steps telescope and a point sticking on the
+    /// obstacle keeps its place on it (THEORY §2: the stick constraint acts on the half-step
+    /// velocity `v_{n+3/2}`, which moves the positions from `t_{n+1}` to `t_{n+2}`).
+    #[inline]
+    pub fn step_velocity(&self, k: u64, dt: f64) -> Vector3<f64> {
+        match self {
+            Motion::Fixed => Vector3::zeros(),
+            _ => (self.at((k + 1) as f64 * dt).0 - self.at(k as f64 * dt).0) / dt,
+        }
+    }
+
+    /// The obstacle's full-step velocity at step `n` (time `t_n = nΔt`): the mean of
+    /// the two step velocities around it, `½ (v_{n−½} + v_{n+½})` ([`Self::step_velocity`]),
+    /// i.e. the central difference `(d(t_{n+1}) − d(t_{n−1}))/(2Δt)`. The structure's
+    /// full-step velocity is the same mean of its half-step velocities,
+    /// `q̇_n = ½ (v_{n−½} + v_{n+½}) = (q_{n+1} − q_{n−1})/(2Δt)` (THEORY §2), so the
+    /// difference of the two is the central difference of the position relative to the
+    /// obstacle: the slip velocity and the friction power (THEORY §5) are measured on it,
+    /// and it is exactly zero (up to round-off) when both half-step velocities were held to
+    /// the obstacle's. `ḋ(t_n)` differs from it by `O(Δt²)`. At `n = 0` (the initial
+    /// velocity is given, not a difference of positions) it is `ḋ(0)`.
+    #[inline]
+    pub fn full_step_velocity(&self, n: u64, dt: f64) -> Vector3<f64> {
+        match (self, n) {
+            (Motion::Fixed, _) => Vector3::zeros(),
+            (_, 0) => self.at(0.0).1,
+            _ => 0.5 * (self.step_velocity(n - 1, dt) + self.step_velocity(n, dt)),
+        }
     }
 
     /// Displacement `d(t)` and velocity `ḋ(t)`.

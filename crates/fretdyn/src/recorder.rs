@@ -157,6 +157,11 @@ impl Recorder {
         self.position[[n, c, 1]] = s.position[1];
     }
 
+    /// Forgets the last sample written (one that must not be kept).
+    pub fn discard_last(&mut self) {
+        self.len = self.len.saturating_sub(1);
+    }
+
     /// Drops the unwritten tail (after an early stop), keeping the samples written.
     pub fn truncate(&mut self) {
         let n = self.len;

@@ -298,13 +298,22 @@ struct ContactState {
     /// Position of the contact point (on the surface for a tube contact) relative to the
     /// moving obstacle: the penalty law's anchor lives in this frame.
     x_relative: Vector3<f64>,
-    /// Point velocity relative to the obstacle (predicted during the step, full-step after).
+    /// Point velocity relative to the obstacle (predicted during the step, full-step after;
+    /// see [`Simulation::full_step_velocities`]).
     v: Vector3<f64>,
     normal_force: f64,
     /// Tangential force of the obstacle on the structure, tangent basis.
     tangential_force: Vector2<f64>,
     closed: bool,
     slide: Slide,
+    /// Lagrange methods: the stick constraint held this contact's full-step velocity to the
+    /// obstacle's — it sticks at this step and, with the half-step constraint, stuck at the
+    /// previous one too, so both half-step velocities whose mean is `q̇_{n+1}` were imposed
+    /// (THEORY §2). Its slip velocity is then zero by construction and is reported as exactly
+    /// 0, without the round-off of `Φ_c q̇_{n+1}` (THEORY §5: in stick `v_T = 0`). Set within
+    /// each step, so not part of a snapshot.
+    #[serde(skip)]
+    held: bool,
 }
 
 impl ContactState {
@@ -316,11 +325,37 @@ impl ContactState {
             + t[1] * self.tangential_force.y
     }
 
+    /// Tangential velocity relative to the obstacle, tangent basis; exactly 0 when
+    /// [held](Self::held) in stick.
     fn tangential_velocity(&self) -> Vector2<f64> {
+        if self.held {
+            return Vector2::zeros();
+        }
         Vector2::new(
             self.frame.tangents[0].dot(&self.v),
             self.frame.tangents[1].dot(&self.v),
         )
+    }
+
+    /// True when `R_N² + |R_T|² + δ² + |v|²` (`v` of a closed contact only: an open one's is
+    /// not used) is at most `bound/4` (false for a non-finite value). Then every increment
+    /// the statistics form from the contact's values is at most `bound`
+    /// ([`Simulation::accumulation_bound`]): the squares of the forces and of the
+    /// penetration, the friction powers `|R_T·v_T| ≤ (|R_T|² + |v|²)/2` and
+    /// `R_N |v_T| ≤ (R_N² + |v|²)/2` (THEORY §5), and the point's offset, which is the
+    /// penetration give or take the obstacle's clearance.
+    #[inline]
+    fn accumulable(&self, bound: f64) -> bool {
+        let v2 = if self.closed {
+            self.v.norm_squared()
+        } else {
+            0.0
+        };
+        self.normal_force * self.normal_force
+            + self.tangential_force.norm_squared()
+            + self.frame.penetration * self.frame.penetration
+            + v2
+            <= 0.25 * bound
     }
 
     fn status_code(&self) -> i8 {
@@ -385,6 +420,8 @@ pub struct Simulation<'m> {
     energy: EnergyBalance,
     recorder: Recorder,
     step: u64,
+    /// [`Self::accumulation_bound`] of the settings.
+    accumulation_bound: f64,
 }
 
 impl<'m> Simulation<'m> {
@@ -635,6 +672,7 @@ impl<'m> Simulation<'m> {
             tangential_force: Vector2::zeros(),
             closed: false,
             slide: Slide::Stick,
+            held: false,
         };
         Ok(Self {
             model,
@@ -655,6 +693,7 @@ impl<'m> Simulation<'m> {
             energy: EnergyBalance::default(),
             recorder: Recorder::new(samples, p, nc),
             step: 0,
+            accumulation_bound: Self::accumulation_bound(settings),
         })
     }
 
@@ -682,26 +721,26 @@ impl<'m> Simulation<'m> {
                 .map(|c| (c.frame.penetration, c.closed)),
         );
         self.full_step_velocities(true);
-        self.sample();
+        // the initial state is the input's: the steps check what they add
+        let _ = self.sample();
     }
 
     /// One step n → n+1: the state, the statistics and, every `output_every` steps, an
-    /// output sample. A non-finite contact force or modal state stops with a [`Divergence`]
-    /// (the statistics then cover the steps before it).
+    /// output sample.
+    ///
+    /// A step whose values cannot all be kept stops the run with a [`Divergence`], and
+    /// nothing of it is kept: the statistics, the energy balance and the samples cover the
+    /// steps before it, and are finite. It is checked before anything is accumulated
+    /// ([`Self::accumulation_bound`]): every contact's forces, penetration and velocity,
+    /// which bound the products the statistics form from them (THEORY §5; the divergence
+    /// names the first such contact), the energy and the powers of the balance (the
+    /// structure's state; no contact named), and at a sample step every value of the sample.
     pub fn step(&mut self) -> std::result::Result<(), Divergence> {
-        match self.try_step()? {
-            Some(k) => Err(Divergence {
-                step: self.step + 1,
-                time: (self.step + 1) as f64 * self.settings.dt,
-                contact: Some(k),
-            }),
-            None => Ok(()),
-        }
+        self.try_step().inspect_err(|_| self.step -= 1)
     }
 
-    /// The step; `Ok(Some(c))` when contact `c`'s force is non-finite, `Err` for a
-    /// non-finite modal state.
-    fn try_step(&mut self) -> std::result::Result<Option<usize>, Divergence> {
+    /// The step; on `Err`, nothing of it was accumulated or sampled.
+    fn try_step(&mut self) -> std::result::Result<(), Divergence> {
         self.step += 1;
         let t = self.step as f64 * self.settings.dt;
         self.cd.predict();
@@ -709,67 +748,51 @@ impl<'m> Simulation<'m> {
         self.detect(t, true);
         self.contact_forces();
         self.cd.free_acceleration(&self.force);
-        self.lagrange(t);
+        self.lagrange();
         self.cd.correct();
         self.full_step_velocities(false);
 
         let dt = self.settings.dt;
-        if let Some(k) = self.contacts.iter().position(|c| {
-            !(c.normal_force.is_finite() && c.tangential_force.iter().all(|v| v.is_finite()))
-        }) {
-            self.step -= 1;
-            return Ok(Some(k));
+        let bound = self.accumulation_bound;
+        let step = self.step;
+        let diverged = move |contact: Option<usize>| Divergence {
+            step,
+            time: t,
+            contact,
+        };
+        if let Some(k) = self.contacts.iter().position(|c| !c.accumulable(bound)) {
+            return Err(diverged(Some(k)));
         }
         let (e, powers) = self.energy_and_powers();
-        if !e.is_finite() {
-            self.step -= 1;
-            return Err(Divergence {
-                step: self.step + 1,
-                time: (self.step + 1) as f64 * dt,
-                contact: None,
-            });
+        let magnitude = e.abs() + powers.iter().map(|p| p.abs()).sum::<f64>();
+        if magnitude > bound || magnitude.is_nan() {
+            return Err(diverged(None));
+        }
+        if self.step % self.settings.output_every == 0 {
+            self.full_step_velocities(true);
+            if let Some(k) = self.sample() {
+                self.recorder.discard_last();
+                return Err(diverged(Some(k)));
+            }
         }
         self.energy.step(e, powers, dt);
         let model = self.model;
-        let values = self.contacts.iter().zip(&model.contacts).map(|(s, c)| {
-            let local = c.local(&s.x, t);
-            let (radial, direction) = if c.obstacle.is_hole() {
-                let r = local.norm();
-                let unit = if r > 0.0 {
-                    [local.x / r, local.y / r]
-                } else {
-                    [1.0, 0.0]
-                };
-                (r, unit)
-            } else {
-                (local.x, [1.0, 0.0])
-            };
-            let (slip_speed, friction_power) = if s.closed {
-                let vt = s.tangential_velocity();
-                (vt.norm(), s.tangential_force.dot(&vt).abs())
-            } else {
-                (0.0, 0.0)
-            };
-            StepValues {
-                t,
-                closed: s.closed,
-                stick: s.slide == Slide::Stick,
-                normal: s.normal_force,
-                tangential: s.tangential_force.norm(),
-                slip_speed,
-                friction_power,
-                penetration: s.frame.penetration,
-                radial,
-                direction,
-            }
-        });
+        let values = self
+            .contacts
+            .iter()
+            .zip(&model.contacts)
+            .map(|(s, c)| step_values(s, c, t));
         self.statistics
             .step(&self.settings.statistics, &self.names, t, dt, values);
-        if self.step % self.settings.output_every == 0 {
-            self.full_step_velocities(true);
-            self.sample();
-        }
-        Ok(None)
+        Ok(())
+    }
+
+    /// Largest value a step may add to a running sum of the statistics or of the energy
+    /// balance (a force, a square, a power, a penetration): `f64::MAX / (8 (N + 1) max(1, Δt))`
+    /// for `N` steps, so that no sum of the run can overflow — a step above it has diverged.
+    /// (About 2e298 for a billion steps: no physical value comes near it.)
+    pub fn accumulation_bound(settings: &RunSettings) -> f64 {
+        f64::MAX / (8.0 * (settings.steps as f64 + 1.0) * settings.dt.max(1.0))
     }
 
     fn external_force(&mut self, t: f64) {
@@ -821,6 +844,7 @@ impl<'m> Simulation<'m> {
             state.frame = c.frame(&state.x, t);
             state.closed = state.frame.penetration > 0.0;
             state.tangential_force = Vector2::zeros();
+            state.held = false;
             if state.closed {
                 // an open contact's velocity is only needed at output samples
                 let rows = if c.at_surface() {
@@ -881,7 +905,7 @@ impl<'m> Simulation<'m> {
     }
 
     /// Step 6 for the Lagrange methods.
-    fn lagrange(&mut self, t: f64) {
+    fn lagrange(&mut self) {
         let Tangential::Lagrange {
             problem,
             solver,
@@ -917,15 +941,20 @@ impl<'m> Simulation<'m> {
         }
         let (contacts, model, dt) = (&self.contacts, self.model, self.settings.dt);
         let half_step = self.settings.stick_velocity == StickVelocity::HalfStep;
+        let step = self.step;
         problem.assemble(&self.cd.qdd, &self.cd.qd_star, *theta_dt, |slot| {
             let f = &contacts[slot.contact].frame;
             let motion = &model.contacts[slot.contact].motion;
-            // the half-step velocity moves the point from t to t + Δt: the obstacle's velocity
-            // over that step, so that a sticking point keeps its place on the obstacle exactly
-            let v = if half_step && !motion.is_fixed() {
-                (motion.at(t + dt).0 - motion.at(t).0) / dt
-            } else {
+            // the half-step velocity moves the point from t_{n+1} to t_{n+2}: the obstacle's
+            // velocity over that step, so that a sticking point keeps its place on the
+            // obstacle exactly; the full-step one is the mean of two such steps
+            // (Motion::full_step_velocity, the velocity the slip is measured against)
+            let v = if motion.is_fixed() {
                 f.velocity
+            } else if half_step {
+                motion.step_velocity(step, dt)
+            } else {
+                motion.full_step_velocity(step, dt)
             };
             Vector2::new(f.tangents[0].dot(&v), f.tangents[1].dot(&v))
         });
@@ -973,6 +1002,13 @@ impl<'m> Simulation<'m> {
             residual.unwrap_or_else(|| problem.natural_map_residual(&lambda[..m], &slide[..m]));
         self.solver_stats.add_residual(residual);
         problem.apply(&lambda[..m], &mut self.cd.qdd);
+        for (k, slot) in problem.slots().iter().enumerate() {
+            // held: both half-step velocities of q̇_{n+1} imposed (only this step's with the
+            // full-step constraint)
+            let before = &history[slot.contact];
+            self.contacts[slot.contact].held = slide[k] == Slide::Stick
+                && (!half_step || (before.closed && before.slide == Slide::Stick));
+        }
         history.iter_mut().for_each(|h| h.closed = false);
         for (k, slot) in problem.slots().iter().enumerate() {
             let state = &mut self.contacts[slot.contact];
@@ -992,7 +1028,12 @@ impl<'m> Simulation<'m> {
         }
     }
 
-    /// Full-step velocities `Φ_c q̇_{n+1}` of the closed contacts (of all when `all`).
+    /// Full-step velocities of the closed contacts (of all when `all`) relative to their
+    /// obstacles: `Φ_c q̇_{n+1} − v̄_{n+1}`, with `v̄` the obstacle's full-step velocity
+    /// ([`crate::motion::Motion::full_step_velocity`], the mean of the two step velocities
+    /// around `t_{n+1}`, as `q̇_{n+1}` is the mean of the two half-step velocities; THEORY §2),
+    /// which also becomes the frame's velocity for the obstacle's power. (The tangential part
+    /// of a contact [held](ContactState::held) in stick is read as exactly 0, THEORY §5.)
     fn full_step_velocities(&mut self, all: bool) {
         let p = self.cd.q.len();
         for (k, (c, state)) in self
@@ -1009,6 +1050,9 @@ impl<'m> Simulation<'m> {
                     c.surface_rows(pt, &state.frame.normal, out);
                 }
                 let rows = contact_rows(self.model, &self.surface_rows, k);
+                if !c.motion.is_fixed() {
+                    state.frame.velocity = moving_full_step(&c.motion, self.step, self.settings.dt);
+                }
                 state.v = recombine(rows, &self.cd.qd) - state.frame.velocity;
             }
         }
@@ -1044,14 +1088,22 @@ impl<'m> Simulation<'m> {
         )
     }
 
-    fn sample(&mut self) {
+    /// Records the output sample of the current step; returns the first contact whose slip
+    /// velocity or position is not finite (the modal state and the forces are checked by
+    /// [`Self::step`] already).
+    fn sample(&mut self) -> Option<usize> {
         let t = self.step as f64 * self.settings.dt;
         if !self.recorder.push_state(t, &self.cd.q, &self.cd.qd) {
-            return;
+            return None;
         }
+        let mut non_finite = None;
         for (k, (s, c)) in self.contacts.iter().zip(&self.model.contacts).enumerate() {
             let vt = s.tangential_velocity();
             let local = c.local(&s.x, t);
+            // a sum is non-finite when a term is (or when it overflows: no value to keep)
+            if !(vt.x + vt.y + local.x + local.y).is_finite() && non_finite.is_none() {
+                non_finite = Some(k);
+            }
             self.recorder.contact(
                 k,
                 &ContactSample {
@@ -1064,6 +1116,7 @@ impl<'m> Simulation<'m> {
                 },
             );
         }
+        non_finite
     }
 
     /// The statistics so far, without ending the run (its recorder is empty).
@@ -1122,6 +1175,47 @@ fn contact_rows<'a>(model: &'a Model, surface_rows: &'a [f64], k: usize) -> &'a 
         &surface_rows[3 * p * k..3 * p * (k + 1)]
     } else {
         &model.basis.points[c.point].rows
+    }
+}
+
+/// [`crate::motion::Motion::full_step_velocity`], out of the loop of the fixed obstacles.
+#[inline(never)]
+fn moving_full_step(motion: &crate::motion::Motion, step: u64, dt: f64) -> Vector3<f64> {
+    motion.full_step_velocity(step, dt)
+}
+
+/// One contact's values of the step ending at `t`, for the statistics (THEORY §5).
+#[inline]
+fn step_values(s: &ContactState, c: &crate::contact::Contact, t: f64) -> StepValues {
+    let local = c.local(&s.x, t);
+    let (radial, direction) = if c.obstacle.is_hole() {
+        let r = local.norm();
+        let unit = if r > 0.0 {
+            [local.x / r, local.y / r]
+        } else {
+            [1.0, 0.0]
+        };
+        (r, unit)
+    } else {
+        (local.x, [1.0, 0.0])
+    };
+    let (slip_speed, friction_power) = if s.closed {
+        let vt = s.tangential_velocity();
+        (vt.norm(), s.tangential_force.dot(&vt).abs())
+    } else {
+        (0.0, 0.0)
+    };
+    StepValues {
+        t,
+        closed: s.closed,
+        stick: s.slide == Slide::Stick,
+        normal: s.normal_force,
+        tangential: s.tangential_force.norm(),
+        slip_speed,
+        friction_power,
+        penetration: s.frame.penetration,
+        radial,
+        direction,
     }
 }
 

@@ -6,8 +6,11 @@
 //! in it, so that bounds that are multiples of Δt split the steps exactly despite round-off. An **impact** starts when the contact closes after being open longer than the rest
 //! duration, and ends at the last opening before such a rest: openings shorter than the rest
 //! duration are **rebounds** within the impact. Its start and end times are interpolated
-//! linearly between steps on the penetration's zero crossing; it is counted in the window
-//! when it starts there. An impact still going on when the run ends is ended there.
+//! linearly between steps on the penetration's zero crossing; it belongs to the window when
+//! the step in which it starts does (the same midpoint rule, not the interpolated start time:
+//! an impact that starts on the window's first step, e.g. a contact closed from `t_start`
+//! exactly, is counted once and has its row, its duration and its peak in the histogram like
+//! any other). An impact still going on when the run ends is ended there.
 
 use serde::{Deserialize, Serialize};
 
@@ -177,6 +180,9 @@ struct ImpactTracker {
     last_opening: f64,
     previous_penetration: f64,
     previous_t: f64,
+    /// The current impact started in a step of the window: it is counted in the window's
+    /// impacts, and its row and duration go to the window's table when it ends.
+    in_window: bool,
 }
 
 impl ImpactTracker {
@@ -190,8 +196,15 @@ impl ImpactTracker {
         }
     }
 
-    /// One step; returns `(started, finished impact)`.
-    fn step(&mut self, contact: usize, v: &StepValues, rest: f64) -> (bool, Option<Impact>) {
+    /// One step, `in_window` when it counts in the window; returns `(started, finished
+    /// impact)` (whether that impact started in the window is [`Self::in_window`]).
+    fn step(
+        &mut self,
+        contact: usize,
+        v: &StepValues,
+        rest: f64,
+        in_window: bool,
+    ) -> (bool, Option<Impact>) {
         let dt = v.t - self.previous_t;
         let mut started = false;
         let mut finished = None;
@@ -207,6 +220,7 @@ impl ImpactTracker {
                     started = true;
                     self.active = true;
                     self.open = false;
+                    self.in_window = in_window;
                     self.current = Some(Impact {
                         contact,
                         start: self.crossing(v),
@@ -593,7 +607,8 @@ impl ContactStatisticsState {
             }
         }
         for (k, v) in values.enumerate() {
-            let (started, finished) = self.trackers[k].step(k, &v, settings.rest_duration);
+            let (started, finished) =
+                self.trackers[k].step(k, &v, settings.rest_duration, in_window);
             if in_window {
                 self.window[k].add_step(&v, dt);
                 self.block[k].add_step(&v, dt);
@@ -603,7 +618,7 @@ impl ContactStatisticsState {
                 }
             }
             if let Some(imp) = finished {
-                if settings.in_window(imp.start) {
+                if self.trackers[k].in_window {
                     self.window[k].add_impact(&imp);
                     self.block[k].add_impact(&imp);
                     self.impacts.push(imp);
@@ -647,7 +662,7 @@ impl ContactStatisticsState {
                 };
                 imp.duration = end - imp.start;
                 tr.active = false;
-                if settings.in_window(imp.start) {
+                if tr.in_window {
                     self.window[k].add_impact(&imp);
                     self.block[k].add_impact(&imp);
                     self.impacts.push(imp);
