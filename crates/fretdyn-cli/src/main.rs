@@ -76,7 +76,7 @@ enum Command {
         #[arg(value_parser = path)]
         dir: PathBuf,
     },
-    /// Run V1a, V1b, V1c (THEORY §6) with every method, compare with the analytic solution,
+    /// Run V1a, V1b, V1c (docs/THEORY.md §6) with every method, compare with the analytic solution,
     /// write the figures; exit code 1 if a check fails.
     Verify {
         /// Output folder for figures and verification.json.

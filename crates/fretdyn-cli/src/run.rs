@@ -463,7 +463,7 @@ fn demo(options: &Options) -> Result<(), Failure> {
     let v1 = V1::reference(20.0);
     if !quiet {
         outln!(
-            "fretdyn demo: V1a, a 1 kg point mass hitting a plane at 1 m/s, 20° from the normal, μ = 0.3 (THEORY §6)"
+            "fretdyn demo: V1a, a 1 kg point mass hitting a plane at 1 m/s, 20° from the normal, μ = 0.3 (docs/THEORY.md §6)"
         )?;
     }
     let mut curves = Vec::new();

@@ -9,6 +9,7 @@ use fretdyn::study::Study;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Failure;
+use crate::out::outln;
 use crate::plot::{Series, panels_plot};
 
 /// Entry point of `fretdyn sweep`.
@@ -66,12 +67,12 @@ pub fn main(
         plot_table(&table, &plot.x, &plot.statistic, &dir.join("study.png"))?;
     }
     if !quiet {
-        println!(
+        outln!(
             "{}: {done} runs in {wall:.2} s ({} already in the table), results in {}",
             study.display(),
             total - done,
             table.display()
-        );
+        )?;
     }
     Ok(())
 }

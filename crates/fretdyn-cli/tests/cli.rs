@@ -394,109 +394,66 @@ fn turbulence_tube_killed_at_half_time_resumes_bit_for_bit() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("nothing to resume"));
 
-    // Ctrl-C (SIGINT): stops after a checkpoint, says how to continue, leaves results.npz
-    let child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
-        .args([
-            "run",
-            case,
-            "-o",
-            "interrupted",
-            "-q",
-            "--no-plots",
-            "--checkpoint-every",
-            "0.2",
-        ])
-        .current_dir(&s.0)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let interrupted = s.0.join("interrupted");
-    while checkpoint_step(&interrupted).is_none_or(|n| n < 200_000) {
-        assert!(start.elapsed().as_secs() < 1200, "no checkpoint");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(
-        stderr.contains("interrupted at step") && stderr.contains("--resume"),
-        "{stderr}"
-    );
-    let stopped = summary(&interrupted);
-    assert_eq!(stopped["termination"]["status"], "stopped");
-    let n = npz_f64(&interrupted, "t").len();
-    assert!(n > 1 && n < npz_f64(&full, "t").len());
-    let out = fretdyn(
-        &["run", "--resume", "interrupted", "-q", "--no-plots"],
-        &s.0,
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert_eq!(summary(&interrupted)["contacts"], a["contacts"]);
-    let (x, y) = (npz_f64(&full, "q"), npz_f64(&interrupted, "q"));
-    assert!(x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()));
-
-    // SIGTERM (timeout, batch schedulers, docker stop): as Ctrl-C
-    let child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
-        .args([
-            "run",
-            case,
-            "-o",
-            "terminated",
-            "-q",
-            "--no-plots",
-            "--checkpoint-every",
-            "0.2",
-        ])
-        .current_dir(&s.0)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let terminated = s.0.join("terminated");
-    while checkpoint_step(&terminated).is_none_or(|n| n < 200_000) {
-        assert!(start.elapsed().as_secs() < 1800, "no checkpoint");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "killed by SIGTERM: {stderr}");
-    assert!(
-        stderr.contains("interrupted at step") && stderr.contains("--resume"),
-        "{stderr}"
-    );
-    assert_eq!(summary(&terminated)["termination"]["status"], "stopped");
-    let stopped_at = checkpoint_step(&terminated).unwrap();
-    assert!((200_000..1_000_000).contains(&stopped_at), "{stopped_at}");
-    let out = fretdyn(&["run", "--resume", "terminated", "-q", "--no-plots"], &s.0);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    for key in ["t", "q", "qdot", "contact_normal_force", "contact_position"] {
-        let (x, y) = (npz_f64(&full, key), npz_f64(&terminated, key));
-        assert_eq!(x.shape(), y.shape(), "{key}");
+    // Ctrl-C (SIGINT) and SIGTERM (timeout, batch schedulers, docker stop) alike: a stop after
+    // a checkpoint that says how to continue and leaves results.npz; resumed, the results are
+    // those of the uninterrupted run, bit for bit
+    for (signal, folder) in [("-INT", "interrupted"), ("-TERM", "terminated")] {
+        let child = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+            .args([
+                "run",
+                case,
+                "-o",
+                folder,
+                "-q",
+                "--no-plots",
+                "--checkpoint-every",
+                "0.2",
+            ])
+            .current_dir(&s.0)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let stopped = s.0.join(folder);
+        while checkpoint_step(&stopped).is_none_or(|n| n < 200_000) {
+            assert!(start.elapsed().as_secs() < 1800, "no checkpoint");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        Command::new("kill")
+            .args([signal, &child.id().to_string()])
+            .status()
+            .unwrap();
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{signal}: {stderr}");
         assert!(
-            x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()),
-            "{key} differs"
+            stderr.contains("interrupted at step") && stderr.contains("--resume"),
+            "{signal}: {stderr}"
+        );
+        assert_eq!(summary(&stopped)["termination"]["status"], "stopped");
+        let stopped_at = checkpoint_step(&stopped).unwrap();
+        assert!((200_000..1_000_000).contains(&stopped_at), "{stopped_at}");
+        let n = npz_f64(&stopped, "t").len();
+        assert!(n > 1 && n < npz_f64(&full, "t").len());
+        let out = fretdyn(&["run", "--resume", folder, "-q", "--no-plots"], &s.0);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for key in ["t", "q", "qdot", "contact_normal_force", "contact_position"] {
+            let (x, y) = (npz_f64(&full, key), npz_f64(&stopped, key));
+            assert_eq!(x.shape(), y.shape(), "{key}");
+            assert!(
+                x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "{signal}: {key} differs"
+            );
+        }
+        assert_eq!(summary(&stopped)["contacts"], a["contacts"]);
+        assert_eq!(
+            std::fs::read_to_string(full.join("impacts.csv")).unwrap(),
+            std::fs::read_to_string(stopped.join("impacts.csv")).unwrap()
         );
     }
-    assert_eq!(summary(&terminated)["contacts"], a["contacts"]);
-    assert_eq!(
-        std::fs::read_to_string(full.join("impacts.csv")).unwrap(),
-        std::fs::read_to_string(terminated.join("impacts.csv")).unwrap()
-    );
 }
 
 /// Checks a refusal: exit code `code`, one line on stderr starting with "error: " and

@@ -97,7 +97,7 @@ impl Case {
 fn load_case(path: PathBuf) -> PyResult<Case> {
     fretdyn::case::Case::from_file(&path)
         .map(|inner| Case { inner })
-        .map_err(|e| FretdynError::new_err(format!("{}: {e}", path.display())))
+        .map_err(|e| FretdynError::new_err(e.in_file(&path)))
 }
 
 /// A case from TOML text; relative file names are resolved from `base_dir`.
@@ -227,8 +227,7 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
 }
 
 fn study(path: &Path) -> PyResult<fretdyn::study::Study> {
-    fretdyn::study::Study::from_file(path)
-        .map_err(|e| FretdynError::new_err(format!("{}: {e}", path.display())))
+    fretdyn::study::Study::from_file(path).map_err(|e| FretdynError::new_err(e.in_file(path)))
 }
 
 /// Number of runs of a study.

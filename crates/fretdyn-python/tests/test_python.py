@@ -42,6 +42,12 @@ def test_v1a_from_python_equals_the_cli_bit_for_bit(tmp_path):
     assert r["summary"]["termination"]["status"] == "completed"
 
 
+def test_a_missing_file_is_named_once(tmp_path):
+    with pytest.raises(fretdyn.FretdynError) as e:
+        fretdyn.Case.from_file(tmp_path / "nothere.toml")
+    assert str(e.value).count("nothere.toml") == 1, str(e.value)
+
+
 def test_errors_are_exceptions_with_the_cli_message(tmp_path):
     text = (EXAMPLES / "v1a_oblique_impact.toml").read_text().replace("dt = 1e-6", "dt = 1e-2")
     (tmp_path / "bad.toml").write_text(text)

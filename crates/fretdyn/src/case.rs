@@ -14,7 +14,7 @@ use crate::eigen::ModeSelection;
 use crate::error::{Error, Result, number};
 use crate::friction::{Coulomb, LocalSolve};
 use crate::load::{BaseAcceleration, ModalLoad, PointLoad, Sine, TimeHistory, TurbulentLoad};
-use crate::modal::{ModalBasis, PinnedBeam, Point};
+use crate::modal::{ModalBasis, PinnedBeam, Point, check_damping_ratio};
 use crate::model::Model;
 use crate::motion::Motion;
 use crate::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
@@ -1011,18 +1011,6 @@ fn check_mode_count(modes: usize, points: usize) -> Result<()> {
     Ok(())
 }
 
-/// A damping ratio given as one number for every mode.
-fn check_damping_ratio(xi: f64, field: &str) -> Result<()> {
-    if xi.is_finite() && xi >= 0.0 {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            field,
-            format!("must be a damping ratio ≥ 0, e.g. 0.01 for 1 % (got {xi})"),
-        ))
-    }
-}
-
 /// Grounded springs `[kx, ky, kz, krx, kry, krz]` (0 = free).
 fn spring_restraints(k: &[f64; 6], field: &str) -> Result<[Restraint; 6]> {
     if let Some(v) = k.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
@@ -1460,7 +1448,7 @@ impl CaseFile {
             return Err(Error::invalid(
                 "time.dt",
                 format!(
-                    "the stable limit of central differences is {stable_dt:.3e} s (a highest frequency of about {:.3e} Hz, THEORY §2): {} s would take more than 1e12 steps; check the units of the structure (masses, densities, sizes, Young's modulus) and of the contact stiffnesses",
+                    "the stable limit of central differences is {stable_dt:.3e} s (a highest frequency of about {:.3e} Hz, docs/THEORY.md §2): {} s would take more than 1e12 steps; check the units of the structure (masses, densities, sizes, Young's modulus) and of the contact stiffnesses",
                     2.0 / (std::f64::consts::TAU * stable_dt),
                     number(duration)
                 ),

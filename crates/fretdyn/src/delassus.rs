@@ -371,7 +371,8 @@ impl TangentialProblem {
 /// In-place Cholesky solve of the SPD `n × n` system `a x = rhs` (rhs overwritten by x).
 /// Only the upper triangle of `a` is read; `diag` must hold its diagonal. A pivot below `tiny`
 /// marks the matrix singular: the factorisation is restarted on `a + shift·I` with the
-/// smallest `shift = tiny·10^k` that succeeds. Returns whether regularisation was needed.
+/// smallest `shift = tiny·10^k` that succeeds; when none does (a non-finite `a`), `x` is NaN.
+/// Returns whether regularisation was needed.
 fn cholesky_solve(a: &mut [f64], diag: &[f64], x: &mut [f64], n: usize, tiny: f64) -> bool {
     // Factor into the lower triangle (diagonal included); the strict upper part keeps `a`.
     let factor = |a: &mut [f64], shift: f64| -> bool {
@@ -407,6 +408,12 @@ fn cholesky_solve(a: &mut [f64], diag: &[f64], x: &mut [f64], n: usize, tiny: f6
         let mut shift = tiny.max(1e-300);
         while !factor(a, shift) {
             shift *= 10.0;
+            if !shift.is_finite() {
+                // a non-finite H (a diverging run): no shift helps. NaN multipliers make the
+                // step non-finite, and the run stops there as diverged (never a hang).
+                x[..n].fill(f64::NAN);
+                return true;
+            }
         }
     }
     for i in 0..n {
@@ -429,6 +436,15 @@ fn cholesky_solve(a: &mut [f64], diag: &[f64], x: &mut [f64], n: usize, tiny: f6
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cholesky_of_a_non_finite_matrix_returns_nan_instead_of_looping() {
+        // a NaN pivot fails every shifted factorisation: this looped forever
+        let mut a = vec![1.0, 0.0, 0.0, f64::NAN];
+        let mut x = vec![1.0, 1.0];
+        assert!(cholesky_solve(&mut a, &[1.0, f64::NAN], &mut x, 2, 1e-12));
+        assert!(x.iter().all(|v| v.is_nan()));
+    }
 
     #[test]
     fn cholesky_matches_dense_solve_and_flags_singular() {

@@ -3,8 +3,8 @@
 //! Nonlinear vibration of a structure reduced on a modal basis that rattles against obstacles
 //! with Coulomb friction, by explicit central differences. The normal contact force is a
 //! penalty law; the tangential force is a penalty law or Lagrange multipliers solved by an
-//! Active Set method or a projected Gauss–Seidel. The specification is `THEORY.md` (shared
-//! docs); section numbers in the doc comments refer to it.
+//! Active Set method or a projected Gauss–Seidel. What it computes is stated in the
+//! repository's `docs/THEORY.md`; "THEORY §n" in the doc comments refers to its sections.
 //!
 //! Data flow, one module per concept:
 //! [`case`] (TOML; a [`tube`] is meshed with [`beam`] elements and reduced by [`eigen`]) →

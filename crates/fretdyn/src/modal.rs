@@ -288,7 +288,8 @@ impl ModalBasis {
     }
 }
 
-fn check_damping_ratio(xi: f64, field: &str) -> Result<()> {
+/// A damping ratio `ξ ≥ 0` (one number for every mode, or one mode's); `field` names it.
+pub(crate) fn check_damping_ratio(xi: f64, field: &str) -> Result<()> {
     if xi.is_finite() && xi >= 0.0 {
         Ok(())
     } else {

@@ -448,6 +448,17 @@ impl<'m> Simulation<'m> {
         let stable_dt = Self::check(model, settings)?;
         let mut sim = Self::allocate(model, settings, stable_dt, samples.max(1))?;
         sim.start();
+        // an initial state so large that its energy overflows cannot give a finite run
+        if !(sim.energy.initial.is_finite() && sim.energy.initial.abs() < sim.accumulation_bound) {
+            return Err(Error::invalid(
+                "initial",
+                format!(
+                    "the initial displacement and velocity give an energy of {:e} J, too large \
+                     to compute with: check their units (m, m/s)",
+                    sim.energy.initial
+                ),
+            ));
+        }
         Ok(sim)
     }
 

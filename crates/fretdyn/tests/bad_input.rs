@@ -586,3 +586,25 @@ fn a_missing_file_is_named_once() {
     let err = Error::invalid("structure", "x");
     assert_eq!(err.in_file(path), "no_such_case.toml: structure: x");
 }
+
+/// An initial velocity whose kinetic energy overflows (found by the fuzz test: 1e300 m/s ran
+/// one step and wrote an infinite initial energy in the summary) is refused before the run.
+#[test]
+fn an_initial_state_whose_energy_overflows_is_refused() {
+    let case = Case::from_toml_str(
+        &replace_once(
+            V1A,
+            "velocity = [0.3420201433256687, 0.0, -0.9396926207859084]",
+            "velocity = [0.3420201433256687, 1e300, -0.9396926207859084]",
+        ),
+        Path::new("."),
+    )
+    .expect("a finite velocity is a valid case file");
+    match fretdyn::simulation::simulate(&case.model, &case.settings) {
+        Err(Error::Invalid { field, message }) => {
+            assert_eq!(field, "initial");
+            assert!(message.contains("units"), "{message}");
+        }
+        other => panic!("expected a refusal, got {:?}", other.map(|r| r.termination)),
+    }
+}
