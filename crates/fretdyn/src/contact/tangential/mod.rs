@@ -7,7 +7,7 @@ pub mod penalty;
 
 use serde::Serialize;
 
-pub use crate::friction::LocalSolve;
+pub use crate::contact::friction::LocalSolve;
 
 /// Which velocity the stick constraint of the Lagrange methods acts on (THEORY §2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -47,7 +47,7 @@ pub struct GaussSeidelSettings {
     /// Stop when `‖λ^{k+1} − λ^k‖ ≤ tol ‖λ^{k+1}‖`...
     pub tolerance: f64,
     /// ... and the natural-map residual
-    /// ([`TangentialProblem::natural_map_residual`](crate::delassus::TangentialProblem::natural_map_residual))
+    /// ([`TangentialProblem::natural_map_residual`](crate::contact::delassus::TangentialProblem::natural_map_residual))
     /// is at most this.
     pub residual_tolerance: f64,
     /// Sweep bound; a step that reaches it is counted as non-converged.
@@ -150,7 +150,7 @@ pub struct SolverStatistics {
     /// (tolerated), Active Set direct solves whose `H_SS` was singular (regularised).
     pub singular_delassus: u64,
     /// Largest natural-map residual of a step (relative; see
-    /// [`TangentialProblem::natural_map_residual`](crate::delassus::TangentialProblem::natural_map_residual)).
+    /// [`TangentialProblem::natural_map_residual`](crate::contact::delassus::TangentialProblem::natural_map_residual)).
     pub residual_max: f64,
     /// Sum of the steps' residuals (the mean is `residual_sum / lagrange_steps`).
     pub residual_sum: f64,

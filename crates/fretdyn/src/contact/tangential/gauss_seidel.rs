@@ -11,8 +11,8 @@
 use nalgebra::Vector2;
 
 use super::GaussSeidelSettings;
-use crate::delassus::TangentialProblem;
-use crate::friction::{LocalSolve, Slide, local_solve};
+use crate::contact::delassus::TangentialProblem;
+use crate::contact::friction::{LocalSolve, Slide, local_solve};
 
 /// Result of one solve.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -3,7 +3,7 @@
 //! bit, to those of an uninterrupted run.
 //!
 //! A streamed run writes in its folder:
-//! - `series/<key>.npy`: one `.npy` file per time history of [`crate::recorder::Recorder`]
+//! - `series/<key>.npy`: one `.npy` file per time history of [`crate::results::recorder::Recorder`]
 //!   (keys of `results.npz`), appended chunk by chunk; the header, rewritten after each
 //!   append, always gives the number of rows completely written, so that `numpy.load` reads
 //!   what a killed run had flushed;
@@ -31,10 +31,12 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::integrator::simulation::{
+    Progress, RunResults, RunSettings, Simulation, Snapshot, Termination,
+};
 use crate::model::Model;
-use crate::recorder::Recorder;
-use crate::simulation::{Progress, RunResults, RunSettings, Simulation, Snapshot, Termination};
-use crate::statistics::{BlockStatistics, Impact};
+use crate::results::recorder::Recorder;
+use crate::results::statistics::{BlockStatistics, Impact};
 
 /// How a streamed run writes and checkpoints.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -547,7 +549,7 @@ impl Files {
         };
         let bytes = encode_checkpoint(&checkpoint)
             .map_err(|e| Error::io(self.dir.join(CHECKPOINT_FILE), e))?;
-        crate::output::write_atomically(&self.dir.join(CHECKPOINT_FILE), |mut f| {
+        crate::files::write_atomically(&self.dir.join(CHECKPOINT_FILE), |mut f| {
             f.write_all(&bytes)?;
             f.sync_data()
         })
@@ -562,7 +564,7 @@ impl Files {
             .iter()
             .map(|s| (s.key.clone(), s.path.clone()))
             .collect();
-        crate::output::write_atomically(&path, |file| {
+        crate::files::write_atomically(&path, |file| {
             // after an error (a full disk), the writer swallows what the ZipWriter's drop
             // writes: the error is reported once, by the caller, and the file removed
             let mut zip = zip::ZipWriter::new(BufWriter::new(FailOnce::new(file)));

@@ -16,7 +16,7 @@
 
 use nalgebra::{Matrix2, Vector2, Vector3};
 
-use crate::friction::Slide;
+use crate::contact::friction::Slide;
 
 /// One closed contact in the tangential problem.
 #[derive(Debug, Clone, Copy, Default)]
@@ -88,7 +88,7 @@ impl TangentialProblem {
             for a in 0..2 {
                 for b in 0..2 {
                     let (r, c) = (2 * contact + a, 2 * other + b);
-                    let v = crate::modal::dot(
+                    let v = crate::structure::modal::dot(
                         &self.l[r * p..(r + 1) * p],
                         &self.al[c * p..(c + 1) * p],
                     );
@@ -195,14 +195,14 @@ impl TangentialProblem {
                 let v = if fixed_r && self.fixed[lc_index / 2] {
                     self.h_fixed[lr_index * self.stride + lc_index]
                 } else {
-                    crate::modal::dot(lr, &self.al[lc_index * p..(lc_index + 1) * p])
+                    crate::structure::modal::dot(lr, &self.al[lc_index * p..(lc_index + 1) * p])
                 };
                 self.h[r * self.stride + c] = v;
                 self.h[c * self.stride + r] = v;
             }
             let vimp = v_imp(&self.slots[r / 2])[r % 2];
-            self.b[r] = crate::modal::dot(lr, qdd_free)
-                + (crate::modal::dot(lr, qd_star) - vimp) / theta_dt;
+            self.b[r] = crate::structure::modal::dot(lr, qdd_free)
+                + (crate::structure::modal::dot(lr, qd_star) - vimp) / theta_dt;
         }
     }
 

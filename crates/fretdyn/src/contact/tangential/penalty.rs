@@ -16,7 +16,7 @@
 use nalgebra::{Vector2, Vector3};
 
 use super::PenaltySettings;
-use crate::friction::{Coulomb, Slide};
+use crate::contact::friction::{Coulomb, Slide};
 
 /// State of one contact under the penalty law.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -5,15 +5,15 @@
 use nalgebra::Vector3;
 
 use crate::case::Case;
+use crate::contact::friction::Coulomb;
+use crate::contact::obstacle::{Obstacle, Plane};
+use crate::contact::tangential::{StickVelocity, TangentialMethod};
 use crate::contact::{Contact, NormalLaw};
-use crate::friction::Coulomb;
-use crate::load::{PointLoad, TimeHistory};
-use crate::modal::{ModalBasis, PinnedBeam};
+use crate::integrator::simulation::RunSettings;
+use crate::integrator::stability::stable_time_step;
+use crate::loads::{PointLoad, TimeHistory};
 use crate::model::Model;
-use crate::obstacle::{Obstacle, Plane};
-use crate::simulation::RunSettings;
-use crate::stability::stable_time_step;
-use crate::tangential::{StickVelocity, TangentialMethod};
+use crate::structure::modal::{ModalBasis, PinnedBeam};
 
 /// Tube properties: PWR-like 19.05 × 1.09 mm steel tube, water inside and outside.
 const LENGTH: f64 = 2.0;

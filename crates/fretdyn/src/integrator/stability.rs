@@ -12,9 +12,9 @@
 
 use nalgebra::{DMatrix, Vector3};
 
+use crate::contact::tangential::TangentialMethod;
 use crate::error::{Error, Result, number};
 use crate::model::{Coordinates, Model};
-use crate::tangential::TangentialMethod;
 
 /// The stable time step of `model` with `method`, s; 0 for a model without one (terms that
 /// are not finite numbers, see [`checked_stable_time_step`]), so that every `Δt` is refused.
@@ -28,14 +28,14 @@ pub fn stable_time_step(model: &Model, method: &TangentialMethod) -> f64 {
 /// naming the mode or the contact it comes from; so is a limit that is 0 or not a number.
 pub fn checked_stable_time_step(model: &Model, method: &TangentialMethod) -> Result<f64> {
     let p = model.basis.modes();
-    let (needed, available) = (memory_bytes(p), crate::beam::available_memory());
+    let (needed, available) = (memory_bytes(p), crate::structure::beam::available_memory());
     if needed > available {
         return Err(Error::invalid(
             "structure",
             format!(
                 "has {p} modes: the stable time step is computed on dense {p} × {p} matrices, which would need {}, more than the {} of memory available; keep fewer modes (at most {:.0})",
-                crate::beam::gigabytes(needed),
-                crate::beam::gigabytes(available),
+                crate::structure::beam::gigabytes(needed),
+                crate::structure::beam::gigabytes(available),
                 (available / (8.0 * DENSE_MATRICES)).sqrt()
             ),
         ));

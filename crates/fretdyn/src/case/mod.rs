@@ -6,27 +6,27 @@ use std::path::Path;
 use nalgebra::{Vector2, Vector3};
 use serde::Deserialize;
 
-use crate::beam::{
-    BeamModel, Dof, Fluid, Material, Mesh, Restraint, Theory, Tube, TubeSection, clamped, pinned,
-};
-use crate::contact::{Contact, NormalLaw};
-use crate::eigen::ModeSelection;
-use crate::error::{Error, Result, number};
-use crate::friction::{Coulomb, LocalSolve};
-use crate::load::{BaseAcceleration, ModalLoad, PointLoad, Sine, TimeHistory, TurbulentLoad};
-use crate::modal::{ModalBasis, PinnedBeam, Point, check_damping_ratio};
-use crate::model::Model;
-use crate::motion::Motion;
-use crate::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
-use crate::simulation::RunSettings;
-use crate::spatial_correlation::{covariance_factor, line_covariance};
-use crate::stability::checked_stable_time_step;
-use crate::statistics::StatisticsSettings;
-use crate::tangential::{
+use crate::contact::friction::{Coulomb, LocalSolve};
+use crate::contact::motion::Motion;
+use crate::contact::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
+use crate::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
-use crate::tube::{Damping, NamedPoint, TubeBasis, TubeStructure, node_at};
-use crate::turbulence::Spectrum;
+use crate::contact::{Contact, NormalLaw};
+use crate::error::{Error, Result, number};
+use crate::integrator::simulation::RunSettings;
+use crate::integrator::stability::checked_stable_time_step;
+use crate::loads::spatial_correlation::{covariance_factor, line_covariance};
+use crate::loads::turbulence::Spectrum;
+use crate::loads::{BaseAcceleration, ModalLoad, PointLoad, Sine, TimeHistory, TurbulentLoad};
+use crate::model::Model;
+use crate::results::statistics::StatisticsSettings;
+use crate::structure::beam::{
+    BeamModel, Dof, Fluid, Material, Mesh, Restraint, Theory, Tube, TubeSection, clamped, pinned,
+};
+use crate::structure::eigen::ModeSelection;
+use crate::structure::modal::{ModalBasis, PinnedBeam, Point, check_damping_ratio};
+use crate::structure::tube::{Damping, NamedPoint, TubeBasis, TubeStructure, node_at};
 
 /// A parsed, validated case.
 #[derive(Debug, Clone)]
@@ -995,16 +995,16 @@ impl TubeInput {
 /// Refuses, before they are allocated, more analytic modes than the memory holds: the rows
 /// of `points` points (3 per mode each) and the dense matrices of the stable time step.
 fn check_mode_count(modes: usize, points: usize) -> Result<()> {
-    let needed =
-        crate::stability::memory_bytes(modes) + 8.0 * 3.0 * modes as f64 * points.max(1) as f64;
-    let available = crate::beam::available_memory();
+    let needed = crate::integrator::stability::memory_bytes(modes)
+        + 8.0 * 3.0 * modes as f64 * points.max(1) as f64;
+    let available = crate::structure::beam::available_memory();
     if needed > available {
         return Err(Error::invalid(
             "structure.modes_per_plane",
             format!(
                 "gives {modes} modes, which would need {} of memory, more than the {} available: keep fewer modes",
-                crate::beam::gigabytes(needed),
-                crate::beam::gigabytes(available)
+                crate::structure::beam::gigabytes(needed),
+                crate::structure::beam::gigabytes(available)
             ),
         ));
     }
@@ -1240,7 +1240,7 @@ impl CaseFile {
             }
             let mut row = vec![0.0; modes];
             for node in t.structure.line_nodes(&t.basis, s0, s1) {
-                crate::modal::project_add(&node.rows, &(f * node.weight), &mut row);
+                crate::structure::modal::project_add(&node.rows, &(f * node.weight), &mut row);
             }
             let history = l.history.history(base, &field)?;
             model
@@ -1284,7 +1284,11 @@ impl CaseFile {
                 for j in 0..factor.ncols() {
                     let mut row = vec![0.0; modes];
                     for (i, node) in nodes.iter().enumerate() {
-                        crate::modal::project_add(&node.rows, &(e * factor[(i, j)]), &mut row);
+                        crate::structure::modal::project_add(
+                            &node.rows,
+                            &(e * factor[(i, j)]),
+                            &mut row,
+                        );
                     }
                     rows.extend(row);
                 }
@@ -1542,7 +1546,7 @@ impl StructureSection {
             } => {
                 let mut basis = match (file, frequencies_hz) {
                     (Some(f), None) => {
-                        let file = crate::output::read_basis_npz(&base.join(f))?;
+                        let file = crate::structure::basis_file::read_basis_npz(&base.join(f))?;
                         warnings.extend(file.warnings);
                         file.basis
                     }

@@ -10,15 +10,15 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::case::Case;
-use crate::contact::{Contact, NormalLaw};
-use crate::friction::Coulomb;
-use crate::modal::{ModalBasis, recombine};
-use crate::model::Model;
-use crate::obstacle::{Obstacle, Plane};
-use crate::simulation::{RunResults, RunSettings};
-use crate::tangential::{
+use crate::contact::friction::Coulomb;
+use crate::contact::obstacle::{Obstacle, Plane};
+use crate::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
+use crate::contact::{Contact, NormalLaw};
+use crate::integrator::simulation::{RunResults, RunSettings};
+use crate::model::Model;
+use crate::structure::modal::{ModalBasis, recombine};
 
 /// Parameters of the V1 case.
 #[derive(Debug, Clone, PartialEq)]

@@ -29,7 +29,7 @@ use serde::Deserialize;
 
 use crate::case::{Case, check_case_text, parse_error};
 use crate::error::{Error, Result};
-use crate::simulation::{RunResults, Simulation, Termination};
+use crate::integrator::simulation::{RunResults, Simulation, Termination};
 
 /// How the parameters' values are combined into runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -458,7 +458,7 @@ impl Study {
 /// Runs `case` for its statistics (THEORY §5) only: neither the time histories (a recorder of
 /// one sample, emptied when full) nor the list of impacts and blocks are kept, so that memory
 /// does not grow with the run's length. The statistics are those of
-/// [`crate::simulation::simulate`] (running sums, which do not depend on what is recorded).
+/// [`crate::integrator::simulation::simulate`] (running sums, which do not depend on what is recorded).
 pub fn run_statistics(case: &Case) -> Result<RunResults> {
     let start = Instant::now();
     let mut sim = Simulation::with_recorder(&case.model, &case.settings, 1)?;

@@ -2,19 +2,19 @@
 //! turned into the modal basis the time integrator uses (and, for the tests, into the
 //! physical-coordinates model of the same finite elements).
 //!
-//! The beam finite elements are in [`crate::beam`], the eigen solver in [`crate::eigen`]. A
+//! The beam finite elements are in [`crate::structure::beam`], the eigen solver in [`crate::structure::eigen`]. A
 //! named point sits at a node; with an `offset` (from the tube axis to a point of its outer
 //! surface, where it touches a support) its rows include the rotations:
 //! `u_surface = u + θ × r`.
 
 use nalgebra::{DMatrix, Vector3};
 
-use crate::beam::{Assembled, BeamModel, Dof, Mesh};
-use crate::eigen::{ModeSelection, Modes, lowest_modes};
 use crate::error::{Error, Result};
-use crate::modal::{ModalBasis, Point};
+use crate::loads::spatial_correlation::LineCell;
 use crate::model::{Model, PhysicalMatrices};
-use crate::spatial_correlation::LineCell;
+use crate::structure::beam::{Assembled, BeamModel, Dof, Mesh};
+use crate::structure::eigen::{ModeSelection, Modes, lowest_modes};
+use crate::structure::modal::{ModalBasis, Point};
 
 /// A named point of the tube: a node, and an offset from the axis.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,13 +1,31 @@
-//! A contact: a structure point, an obstacle, the normal penalty law and the Coulomb
-//! coefficients (THEORY §3, §4).
+//! **Stage 4 — the contacts.** What enters: a point of the modal basis, an obstacle (possibly
+//! moving), the normal law and the friction coefficients. What leaves: per contact, the gap
+//! and frame ([`obstacle`]), the normal penalty force ([`NormalLaw`], THEORY §3) and the
+//! tangential force from a friction law ([`friction`]) or from the Lagrange problem on the
+//! Delassus operator ([`delassus`]) solved by the [`tangential`] methods (THEORY §4, §7, §8).
+//!
+//! - [`obstacle`]: planes, bi-planes, circles, polygons: gap, normal, tangent frame;
+//! - [`motion`]: the imposed motion of an obstacle (THEORY §8);
+//! - [`friction`]: Coulomb coefficients, the local stick/slip solve;
+//! - [`delassus`]: the tangential problem `W λ + b` on the closed contacts (THEORY §4.2);
+//! - [`tangential`]: penalty, Active Set and projected Gauss–Seidel (THEORY §4.1, §4.3, §4.4).
+//!
+//! A contact itself ([`Contact`]: structure point, obstacle, normal law, Coulomb
+//! coefficients) is defined here.
 
+pub mod delassus;
+pub mod friction;
+pub mod motion;
+pub mod obstacle;
+pub mod tangential;
+
+use crate::contact::friction::Coulomb;
 use crate::error::{Error, Result};
-use crate::friction::Coulomb;
 use nalgebra::Vector3;
 
-use crate::modal::Point;
-use crate::motion::Motion;
-use crate::obstacle::{ContactFrame, Obstacle};
+use crate::contact::motion::Motion;
+use crate::contact::obstacle::{ContactFrame, Obstacle};
+use crate::structure::modal::Point;
 
 /// Normal penalty law `R_N = max(0, K_N δ + C_N δ̇)` for `δ > 0`, `R_N = 0` otherwise (THEORY §3).
 #[derive(Debug, Clone, Copy, PartialEq)]

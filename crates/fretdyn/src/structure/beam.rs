@@ -506,7 +506,7 @@ fn check_mesh_size(
 }
 
 /// Dense `n × n` matrices of `f64` alive at once at the peak of a tube's modal analysis
-/// ([`BeamModel::assemble`] then [`crate::eigen::lowest_modes`]): the reduced mass and
+/// ([`BeamModel::assemble`] then [`crate::structure::eigen::lowest_modes`]): the reduced mass and
 /// stiffness, the Cholesky factor, the transformed matrix, the eigenvectors and the eigen
 /// solver's workspace: the peak resident memory of `fretdyn modes` on a 3 006-DOF tube is
 /// 7.6 × `8 n²` bytes; 9 leaves a margin.

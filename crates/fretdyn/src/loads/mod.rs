@@ -1,9 +1,16 @@
+//! **Stage 3 — the loads.** What enters: the modal basis and the load sections of a case.
+//! What leaves: the modal force `f(t)` the integrator adds at each step (THEORY §8, §10).
+//!
 //! External loads. Every deterministic load is a fixed modal vector times a scalar history,
 //! projected once on the modes: point forces (`f_q(t) = Σ_l s_l(t) Φ_lᵀ F_l`), line loads along
 //! a tube (lumped at its nodes, `Σ_i w_i Φ_iᵀ f`), modal forces given directly, and a base
 //! acceleration (`f_q = −s(t) Γ A`). Histories: constant, harmonic, sums of sines, tables
-//! (interpolated linearly, held at their end values). Random turbulence is in
-//! [`crate::turbulence`]. See `docs/LOADS.md`.
+//! (interpolated linearly, held at their end values); they are defined here. Random
+//! turbulence ([`TurbulentLoad`]) is synthesised by [`turbulence`] with the spatial
+//! correlation of [`spatial_correlation`]. See `docs/LOADS.md`.
+
+pub mod spatial_correlation;
+pub mod turbulence;
 
 use nalgebra::Vector3;
 
@@ -216,7 +223,7 @@ impl PointLoad {
 /// plate vibration, seismic motion. The structure is then described relatively to the base —
 /// its displacements, and those of the obstacles attached to the base, are relative — and the
 /// base loads the modes with the inertia force `−Γ a(t)`, `Γ = Φᵀ M r` the modal
-/// participation factors ([`crate::modal::ModalBasis::participation`]).
+/// participation factors ([`crate::structure::modal::ModalBasis::participation`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BaseAcceleration {
     /// Acceleration vector `A`, m/s² (global axes).
@@ -260,15 +267,15 @@ fn check_history(history: &TimeHistory, field: &str) -> Result<()> {
 }
 
 /// Random turbulence on the modes: `r` independent stationary Gaussian signals `ξ_j(t)` of
-/// one-sided PSD `S(f)` ([`crate::turbulence::RandomChannels`], seeded, a pure function of
+/// one-sided PSD `S(f)` ([`crate::loads::turbulence::RandomChannels`], seeded, a pure function of
 /// time), each loading the modes along a fixed vector `g_j`: `f_q(t) = Σ_j ξ_j(t) g_j`.
 /// For a tube, `g_j = Σ_i L_ij Φ_iᵀ e` with `L` the factor of the spatial correlation
-/// ([`crate::spatial_correlation::line_covariance`]) of the nodes along the span, and `e` a
+/// ([`crate::loads::spatial_correlation::line_covariance`]) of the nodes along the span, and `e` a
 /// direction of the force.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TurbulentLoad {
     /// PSD of the force per unit length, (N/m)²/Hz.
-    pub spectrum: crate::turbulence::Spectrum,
+    pub spectrum: crate::loads::turbulence::Spectrum,
     /// The vectors `g_j`, one row of p per channel (r × p, row-major).
     pub rows: Vec<f64>,
     /// Seed of the signals.

@@ -21,8 +21,8 @@
 use nalgebra::Vector2;
 
 use super::{ActiveSetSettings, SolverStatistics, gauss_seidel};
-use crate::delassus::TangentialProblem;
-use crate::friction::{LocalSolve, Slide, local_solve};
+use crate::contact::delassus::TangentialProblem;
+use crate::contact::friction::{LocalSolve, Slide, local_solve};
 
 /// Memory of a contact between steps: its last status and slip direction.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]

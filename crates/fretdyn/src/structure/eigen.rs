@@ -83,7 +83,7 @@ pub fn lowest_modes(
     }
     let sigma = 1e-8 * ratio.max(f64::MIN_POSITIVE);
     // the n × n matrices are dropped as soon as they are used: the memory at the peak is
-    // counted by `crate::beam::DENSE_MATRICES_AT_PEAK`
+    // counted by `crate::structure::beam::DENSE_MATRICES_AT_PEAK`
     let llt = Mat::<f64>::from_fn(n, n, |i, j| stiffness[(i, j)] + sigma * mass[(i, j)])
         .llt(Side::Lower)
         .map_err(|e| {

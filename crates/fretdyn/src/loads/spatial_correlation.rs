@@ -11,7 +11,7 @@
 //! ```
 //!
 //! Forces with that covariance are `F = L ξ`, `L Lᵀ ≈ C` ([`covariance_factor`]), with `ξ_j`
-//! independent signals of PSD `S` ([`crate::turbulence::RandomChannels`]).
+//! independent signals of PSD `S` ([`crate::loads::turbulence::RandomChannels`]).
 //! [`correlated_factor`] is the lumped model of point nodes, `C_ik = w_i w_k exp(−|x_i − x_k|/λ)`.
 
 use nalgebra::DMatrix;
@@ -271,7 +271,7 @@ pub fn covariance_factor(covariance: DMatrix<f64>, tolerance: f64) -> Result<DMa
 ///
 /// `positions` `x_i` (m) and `weights` `w_i` (the length of tube attached to node `i`, m) give
 /// nodal forces `F_i = Σ_j L_ij ξ_j(t)` with cross-PSD `S(f) w_i w_k exp(−|x_i − x_k|/λ)` when
-/// the `ξ_j` are independent with PSD `S` ([`crate::turbulence::RandomChannels`]). `λ = ∞` (fully correlated)
+/// the `ξ_j` are independent with PSD `S` ([`crate::loads::turbulence::RandomChannels`]). `λ = ∞` (fully correlated)
 /// gives rank 1, `λ = 0` independent nodes (`L = diag(w)` up to column order). An all-zero
 /// `w` gives one zero column. Input errors name the argument (`positions`, `weights`,
 /// `correlation_length`, `tolerance`).

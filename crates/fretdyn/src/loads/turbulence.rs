@@ -1,7 +1,7 @@
 //! Random turbulence loads: a one-sided power spectral density of a force per unit length
 //! ([`Spectrum`]) and `r` independent stationary Gaussian signals with that spectrum that are a
 //! pure function of time ([`RandomChannels`]). Their spatial correlation along the tube is
-//! [`crate::spatial_correlation`]. `docs/LOADS.md`, section "Random turbulence", states the
+//! [`crate::loads::spatial_correlation`]. `docs/LOADS.md`, section "Random turbulence", states the
 //! models, their sources and the measured accuracy.
 //!
 //! The nodal turbulent force is
@@ -45,7 +45,7 @@ pub enum Spectrum {
     /// with Code_Aster's defaults `Φ₀ = 1.5e-3`, `β = 2.7`, `f_Rc = 0.1`
     /// ([`Spectrum::cross_flow`]). Integrated over `[0, ∞)`:
     /// `σ² = (½ρV²D)² Φ₀ f_Rc (π/β) / sin(π/β)` (β > 1). The spatial correlation that goes with
-    /// it is `exp(−|Δx|/λ)` ([`crate::spatial_correlation`]); Code_Aster gives `λ` as a multiple of `D`.
+    /// it is `exp(−|Δx|/λ)` ([`crate::loads::spatial_correlation`]); Code_Aster gives `λ` as a multiple of `D`.
     ///
     /// The formula is evaluated as written and taken as one-sided. Code_Aster defines its
     /// interspectra as two-sided transforms; if these defaults follow that convention, the

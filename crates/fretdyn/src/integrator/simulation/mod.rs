@@ -9,22 +9,22 @@ use std::time::Instant;
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::central_difference::CentralDifference;
-use crate::delassus::{Slot, TangentialProblem};
+use crate::contact::delassus::{Slot, TangentialProblem};
+use crate::contact::friction::Slide;
+use crate::contact::obstacle::ContactFrame;
+use crate::contact::tangential::active_set::{ActiveSet, History};
+use crate::contact::tangential::penalty::PenaltyContact;
+use crate::contact::tangential::{SolverStatistics, StickVelocity, TangentialMethod, gauss_seidel};
 use crate::error::{Error, Result};
-use crate::friction::Slide;
-use crate::modal::{dot, project_add, recombine};
+use crate::integrator::central_difference::CentralDifference;
+use crate::integrator::stability::stable_time_step;
 use crate::model::Model;
-use crate::obstacle::ContactFrame;
-use crate::recorder::{ContactSample, Recorder};
-use crate::stability::stable_time_step;
-use crate::statistics::{
+use crate::results::recorder::{ContactSample, Recorder};
+use crate::results::statistics::{
     BlockStatistics, ContactStatistics, ContactStatisticsState, EnergyBalance, EnergyRaw, Impact,
     StatisticsSettings, StepValues,
 };
-use crate::tangential::active_set::{ActiveSet, History};
-use crate::tangential::penalty::PenaltyContact;
-use crate::tangential::{SolverStatistics, StickVelocity, TangentialMethod, gauss_seidel};
+use crate::structure::modal::{dot, project_add, recombine};
 
 /// Numerical settings of a run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -89,7 +89,7 @@ impl RunSettings {
     }
 }
 
-fn check_gs(g: &crate::tangential::GaussSeidelSettings, field: &str) -> Result<()> {
+fn check_gs(g: &crate::contact::tangential::GaussSeidelSettings, field: &str) -> Result<()> {
     if !(g.tolerance.is_finite() && g.tolerance > 0.0) {
         return Err(Error::invalid(
             format!("{field}.tolerance"),
@@ -371,7 +371,7 @@ impl ContactState {
 #[allow(clippy::large_enum_variant)]
 enum Tangential {
     Penalty {
-        settings: crate::tangential::PenaltySettings,
+        settings: crate::contact::tangential::PenaltySettings,
         contacts: Vec<PenaltyContact>,
     },
     Lagrange {
@@ -389,7 +389,7 @@ enum Tangential {
 }
 
 enum LagrangeSolver {
-    GaussSeidel(crate::tangential::GaussSeidelSettings),
+    GaussSeidel(crate::contact::tangential::GaussSeidelSettings),
     ActiveSet(Box<ActiveSet>),
 }
 
@@ -408,7 +408,7 @@ pub struct Simulation<'m> {
     /// Modal loads `Φ_lᵀ F_l`, one row of p per load.
     load_rows: Vec<f64>,
     /// Signal generators of the turbulent loads, one per load.
-    turbulence: Vec<crate::turbulence::RandomChannels>,
+    turbulence: Vec<crate::loads::turbulence::RandomChannels>,
     /// Work space: the turbulence signals at the current time.
     signals: Vec<f64>,
     external: Vec<f64>,
@@ -639,7 +639,7 @@ impl<'m> Simulation<'m> {
             .iter()
             .enumerate()
             .map(|(k, l)| {
-                crate::turbulence::RandomChannels::new(
+                crate::loads::turbulence::RandomChannels::new(
                     &l.spectrum,
                     l.channels(p),
                     l.seed,
@@ -1041,7 +1041,7 @@ impl<'m> Simulation<'m> {
 
     /// Full-step velocities of the closed contacts (of all when `all`) relative to their
     /// obstacles: `Φ_c q̇_{n+1} − v̄_{n+1}`, with `v̄` the obstacle's full-step velocity
-    /// ([`crate::motion::Motion::full_step_velocity`], the mean of the two step velocities
+    /// ([`crate::contact::motion::Motion::full_step_velocity`], the mean of the two step velocities
     /// around `t_{n+1}`, as `q̇_{n+1}` is the mean of the two half-step velocities; THEORY §2),
     /// which also becomes the frame's velocity for the obstacle's power. (The tangential part
     /// of a contact [held](ContactState::held) in stick is read as exactly 0, THEORY §5.)
@@ -1189,9 +1189,9 @@ fn contact_rows<'a>(model: &'a Model, surface_rows: &'a [f64], k: usize) -> &'a 
     }
 }
 
-/// [`crate::motion::Motion::full_step_velocity`], out of the loop of the fixed obstacles.
+/// [`crate::contact::motion::Motion::full_step_velocity`], out of the loop of the fixed obstacles.
 #[inline(never)]
-fn moving_full_step(motion: &crate::motion::Motion, step: u64, dt: f64) -> Vector3<f64> {
+fn moving_full_step(motion: &crate::contact::motion::Motion, step: u64, dt: f64) -> Vector3<f64> {
     motion.full_step_velocity(step, dt)
 }
 

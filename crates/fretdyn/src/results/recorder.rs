@@ -27,7 +27,7 @@ pub struct Recorder {
     /// Position of the point relative to the obstacle (N, c, 2), m: for a hole, the offset
     /// of the tube axis from the hole's centre in the hole's axes `(e1, e2)` — its orbit; for
     /// a plane or bars, the distance from the plane (mid-plane) and the position along `t1`
-    /// ([`crate::obstacle::Obstacle::local`]).
+    /// ([`crate::contact::obstacle::Obstacle::local`]).
     pub position: Array3<f64>,
     len: usize,
 }
