@@ -60,6 +60,11 @@ pub mod apps;
 pub mod error;
 mod files;
 
+// The README's Rust example is compiled with the doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+struct ReadmeDoctests;
+
 pub use case::Case;
 pub use error::{Error, Result};
 pub use integrator::simulation::{RunResults, RunSettings, simulate};

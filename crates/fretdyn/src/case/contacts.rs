@@ -121,7 +121,7 @@ impl CaseFile {
     pub(super) fn build_contacts(&self, tube: Option<&TubeModel>, model: &mut Model) -> Result<()> {
         for (k, c) in self.contacts.iter().enumerate() {
             let field = format!("contacts[{k}]");
-            let pt = point_index(&c.point, format!("{field}.point"), &model)?;
+            let pt = point_index(&c.point, format!("{field}.point"), model)?;
             let obstacle = match c.obstacle {
                 ObstacleInput::Plane {
                     origin,

@@ -297,7 +297,7 @@ impl CaseFile {
     ) -> Result<()> {
         for (k, l) in self.loads.iter().enumerate() {
             let field = format!("loads[{k}]");
-            let pt = point_index(&l.point, format!("{field}.point"), &model)?;
+            let pt = point_index(&l.point, format!("{field}.point"), model)?;
             let history = l.history.history(base, &field)?;
             model
                 .loads

@@ -514,7 +514,7 @@ impl CaseFile {
             let p = model.basis.modes();
             match (&init.point, &init.q, &init.qdot) {
                 (Some(name), None, None) => {
-                    let pt = point_index(name, "initial.point".into(), &model)?;
+                    let pt = point_index(name, "initial.point".into(), model)?;
                     for (key, v, unit) in [
                         ("displacement", init.displacement, "m"),
                         ("velocity", init.velocity, "m/s"),

@@ -1,8 +1,9 @@
 //! Files: `results.npz` (time histories, opened by `numpy.load`) and `summary.json`
 //! (THEORY §5).
 //!
-//! Results are written to a temporary name and renamed ([`write_atomically`]), so a failed
+//! Results are written to a temporary name and renamed (`files::write_atomically`), so a failed
 //! write never leaves a truncated file under the final name.
+
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
