@@ -1,5 +1,7 @@
-//! The model: modal basis, contacts, loads and initial state — everything a run needs except
-//! the numerical settings.
+//! **Stage 5 — the model.** What enters: the modal basis ([`crate::structure`]), the contacts
+//! ([`crate::contact`]) and the loads ([`crate::loads`]), as the case built them. What leaves:
+//! the [`Model`] the integrator steps — modal basis, contacts, loads and initial state,
+//! everything a run needs except the numerical settings (THEORY §1, §2).
 
 use crate::contact::Contact;
 use crate::error::{Error, Result};

@@ -12,6 +12,10 @@
 //!
 //! with `ξ_j` the unit-less channels of [`RandomChannels`] (one-sided PSD `S(f)`), so that the
 //! cross-PSD of the nodal forces is `S(f) C_ik` (`N_i` the shape function of node `i`).
+//!
+//! One concept, kept whole (the longest module of the crate): the spectra, the synthesis of
+//! the signals from them and the generator's state across blocks are one model of the random
+//! force; each part is checked against the others in its tests.
 
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;

@@ -3,13 +3,15 @@
 //! checkpoints (THEORY §5, §11).
 //!
 //! - [`recorder`]: the sampled time histories kept in memory;
-//! - [`statistics`]: per-contact wear work rate, impacts, slip, energy balance (THEORY §5, §11);
+//! - [`statistics`]: per-contact wear work rate, impacts, slip, blocks (THEORY §5, §11);
+//! - [`energy`]: the discrete energy balance (THEORY §5);
 //! - [`output`]: `results.npz` and `summary.json`;
 //! - [`stream`]: long runs streamed to disk by chunks, checkpoints and resume.
 //!
-//! The step loop ([`crate::integrator`]) writes into [`recorder`] and [`statistics`];
+//! The step loop ([`crate::integrator`]) writes into [`recorder`], [`statistics`] and [`energy`];
 //! [`output`] and [`stream`] read the finished or running simulation.
 
+pub mod energy;
 pub mod output;
 pub mod recorder;
 pub mod statistics;

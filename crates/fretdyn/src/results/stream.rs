@@ -21,6 +21,10 @@
 //!
 //! Memory does not grow with the run's length: the recorder holds one chunk, finished impacts
 //! and blocks are written out at each flush, and the statistics are running sums.
+//!
+//! One concept, kept whole: the files of a streamed run, their chunked writing, the checkpoint
+//! that records their lengths and the resume that truncates them back are one format; none
+//! reads right without the others.
 
 use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Read, Seek, SeekFrom, Write};

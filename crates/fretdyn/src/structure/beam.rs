@@ -16,6 +16,9 @@
 //! does not follow the tube's axial motion or twist). With Timoshenko, the rotary inertia
 //! `ρI` of the section is added (`ρI/(30L) [36, 3L, −36, 3L; 3L, 4L², −3L, −L²; …]`); the
 //! consistent mass is otherwise the Euler–Bernoulli one.
+//!
+//! One concept, kept whole: the element matrices, their assembly and the restraints share the
+//! numbering of the degrees of freedom.
 
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 

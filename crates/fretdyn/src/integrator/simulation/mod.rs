@@ -39,8 +39,9 @@ use crate::error::{Error, Result};
 use crate::integrator::central_difference::CentralDifference;
 use crate::integrator::stability::stable_time_step;
 use crate::model::Model;
+use crate::results::energy::{EnergyBalance, EnergyRaw};
 use crate::results::recorder::Recorder;
-use crate::results::statistics::{ContactStatisticsState, EnergyBalance, EnergyRaw};
+use crate::results::statistics::ContactStatisticsState;
 use crate::structure::modal::project_add;
 
 /// Everything that the steps after step `step` depend on: a run restored from it continues

@@ -9,8 +9,9 @@ use super::{RunSettings, Simulation};
 use crate::contact::tangential::SolverStatistics;
 use crate::error::Result;
 use crate::model::Model;
+use crate::results::energy::EnergyBalance;
 use crate::results::recorder::Recorder;
-use crate::results::statistics::{BlockStatistics, ContactStatistics, EnergyBalance, Impact};
+use crate::results::statistics::{BlockStatistics, ContactStatistics, Impact};
 use std::time::Instant;
 
 /// Progress report passed to the observer of [`run`].
