@@ -1,6 +1,9 @@
 //! `[[contacts]]`: obstacles (plane, bi-plane, circle, polygon), their motion, the normal
 //! law and the friction coefficients (THEORY §3, §4, §7, §8).
 
+use nalgebra::{Vector2, Vector3};
+use serde::Deserialize;
+
 use super::{CaseFile, TubeModel, point_index, v3};
 use crate::contact::friction::Coulomb;
 use crate::contact::motion::Motion;
@@ -8,8 +11,6 @@ use crate::contact::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
 use crate::contact::{Contact, NormalLaw};
 use crate::error::{Error, Result, number};
 use crate::model::Model;
-use nalgebra::{Vector2, Vector3};
-use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -2,14 +2,16 @@
 //! histories (inline or tables read from files) and their projection on the modes
 //! (THEORY §8, §10).
 
+use std::path::Path;
+
+use serde::Deserialize;
+
 use super::{CaseFile, TubeModel, point_index, v3};
 use crate::error::{Error, Result, number};
 use crate::loads::spatial_correlation::{covariance_factor, line_covariance};
 use crate::loads::turbulence::Spectrum;
 use crate::loads::{BaseAcceleration, ModalLoad, PointLoad, Sine, TimeHistory, TurbulentLoad};
 use crate::model::Model;
-use serde::Deserialize;
-use std::path::Path;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

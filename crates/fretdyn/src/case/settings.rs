@@ -1,6 +1,8 @@
 //! `[time]`, `[tangential]`, `[output]`, `[statistics]`: the numerical settings of a run
 //! (THEORY §2, §4, §5).
 
+use serde::Deserialize;
+
 use super::CaseFile;
 use crate::contact::friction::LocalSolve;
 use crate::contact::tangential::{
@@ -11,7 +13,6 @@ use crate::integrator::simulation::RunSettings;
 use crate::integrator::stability::checked_stable_time_step;
 use crate::model::Model;
 use crate::results::statistics::StatisticsSettings;
-use serde::Deserialize;
 
 /// `[statistics]`: the window, blocks, impact definition and wear coefficient (THEORY §5).
 #[derive(Debug, Default, Deserialize)]

@@ -2,6 +2,11 @@
 //! inline or from `.npz`, or a tube meshed and reduced on its modes) and the initial state
 //! (THEORY §1, §7, §9).
 
+use std::path::Path;
+
+use nalgebra::Vector3;
+use serde::Deserialize;
+
 use super::{CaseFile, point_index, v3};
 use crate::error::{Error, Result, number};
 use crate::model::Model;
@@ -11,9 +16,6 @@ use crate::structure::beam::{
 use crate::structure::eigen::ModeSelection;
 use crate::structure::modal::{ModalBasis, PinnedBeam, Point, check_damping_ratio};
 use crate::structure::tube::{Damping, NamedPoint, TubeBasis, TubeStructure, node_at};
-use nalgebra::Vector3;
-use serde::Deserialize;
-use std::path::Path;
 
 #[derive(Debug, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]

@@ -3,9 +3,10 @@
 //! follow from them (THEORY §2 step 3, §3, §7, §8); after the step, the full-step
 //! velocities.
 
+use nalgebra::{Vector2, Vector3};
+
 use super::{Simulation, Tangential, contact_rows, contact_states};
 use crate::structure::modal::recombine;
-use nalgebra::{Vector2, Vector3};
 
 impl Simulation<'_> {
     pub(super) fn external_force(&mut self, t: f64) {

@@ -1,9 +1,10 @@
 //! The numerical settings of a run ([`RunSettings`]) and their checks.
 
+use serde::Serialize;
+
 use crate::contact::tangential::{StickVelocity, TangentialMethod};
 use crate::error::{Error, Result};
 use crate::results::statistics::StatisticsSettings;
-use serde::Serialize;
 
 /// Numerical settings of a run.
 #[derive(Debug, Clone, PartialEq, Serialize)]

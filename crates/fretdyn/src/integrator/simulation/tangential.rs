@@ -2,6 +2,8 @@
 //! contacts, solved by projected Gauss–Seidel or Active Set, applied to the acceleration
 //! (THEORY §2 step 6, §4.2–§4.6).
 
+use nalgebra::Vector2;
+
 use super::{RunSettings, Simulation, contact_rows};
 use crate::contact::delassus::{Slot, TangentialProblem};
 use crate::contact::friction::Slide;
@@ -10,7 +12,6 @@ use crate::contact::tangential::penalty::PenaltyContact;
 use crate::contact::tangential::{StickVelocity, gauss_seidel};
 use crate::integrator::central_difference::CentralDifference;
 use crate::model::Model;
-use nalgebra::Vector2;
 
 impl Simulation<'_> {
     /// Step 6 for the Lagrange methods.
