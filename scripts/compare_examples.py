@@ -7,7 +7,7 @@ For each `examples/*.toml` case: `fretdyn run CASE -o DIR --quiet --no-plots` wi
 then every array of `results.npz` must be identical (same shape, dtype and bits; NaN equal to
 NaN), and `summary.json` identical but for what measures the machine (wall time, steps/s). For
 each study file (`base = ...`): `fretdyn sweep` with both, and `study.csv` identical but for its
-wall-time column. Prints one line per example and exits 1 if any differs.
+wall-time and steps/s columns. Prints one line per example and exits 1 if any differs.
 
 Use it to show that a refactoring changed no result: build the old revision into one target
 folder (`git worktree add /tmp/old REV && cargo build --release --manifest-path /tmp/old/Cargo.toml`)
@@ -111,7 +111,8 @@ def main():
             rows = []
             for d in dirs:
                 with open(d / "study.csv", newline="") as f:
-                    rows.append([{k: v for k, v in r.items() if "wall" not in k}
+                    rows.append([{k: v for k, v in r.items()
+                                  if "wall" not in k and k not in MACHINE_KEYS}
                                  for r in csv.DictReader(f)])
             rows = [sorted(r, key=lambda x: json.dumps(x, sort_keys=True)) for r in rows]
             diff = None if rows[0] == rows[1] else "study.csv differs"

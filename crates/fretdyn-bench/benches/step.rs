@@ -3,12 +3,12 @@
 //! Run: cargo bench -p fretdyn-bench --bench step
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use fretdyn::benchmark::rattling_tube;
-use fretdyn::simulation::simulate;
-use fretdyn::tangential::{
+use fretdyn::apps::benchmark::rattling_tube;
+use fretdyn::apps::verification::V1;
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
-use fretdyn::verification::V1;
+use fretdyn::integrator::simulation::simulate;
 
 fn methods() -> [TangentialMethod; 3] {
     [

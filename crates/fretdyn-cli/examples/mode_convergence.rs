@@ -13,7 +13,7 @@ mod plot;
 use std::path::Path;
 
 use fretdyn::case::Case;
-use fretdyn::simulation::simulate;
+use fretdyn::integrator::simulation::simulate;
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");

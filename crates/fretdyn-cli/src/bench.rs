@@ -1,12 +1,12 @@
 //! `fretdyn bench`: steps per second of V1 and of the synthetic rattling tube, per method.
 
-use fretdyn::benchmark::rattling_tube;
+use fretdyn::apps::benchmark::rattling_tube;
+use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
-use fretdyn::simulation::simulate;
-use fretdyn::tangential::{
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
-use fretdyn::verification::V1;
+use fretdyn::integrator::simulation::simulate;
 
 use std::path::Path;
 

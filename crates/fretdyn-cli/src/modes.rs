@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use fretdyn::beam::Dof;
 use fretdyn::case::{Case, TubeModel};
+use fretdyn::structure::beam::Dof;
 
 use crate::Failure;
 use crate::out::outln;
@@ -40,11 +40,12 @@ pub fn main(path: &Path, output: Option<PathBuf>, shown: usize) -> Result<(), Fa
             tube.structure.beam.mesh.nodes.len(),
             tube.structure.beam.mesh.elements.len(),
             a.mass.nrows(),
-            fretdyn::eigen::orthonormality_error(&a.mass, &tube.basis.modes.shapes)
+            fretdyn::structure::eigen::orthonormality_error(&a.mass, &tube.basis.modes.shapes)
         )?;
     }
     let npz = dir.join("basis.npz");
-    fretdyn::output::write_basis_npz(&npz, basis).map_err(|e| Failure::failed(e.to_string()))?;
+    fretdyn::structure::basis_file::write_basis_npz(&npz, basis)
+        .map_err(|e| Failure::failed(e.to_string()))?;
     outln!(
         "wrote {} (keys: frequencies_hz, damping_ratio, rows_<point>, coords_<point>)",
         npz.display()

@@ -389,11 +389,6 @@ fn canvas_on<'p>(
     Ok((root, panels))
 }
 
-/// The canvas of `n` stacked panels, 300 px each, the full width.
-fn stacked<'p>(path: &'p Path, title: &str, n: usize) -> DrawResult<(Area<'p>, Vec<Area<'p>>)> {
-    canvas(path, stacked_size(n), title, (n.max(1), 1))
-}
-
 /// Size of a canvas of `n` stacked panels.
 fn stacked_size(n: usize) -> (u32, u32) {
     (WIDTH, 60 + 300 * n.max(1) as u32)
@@ -608,13 +603,17 @@ pub fn xy_panels(
     y_label: &str,
     panels: &[(String, Vec<Series>)],
 ) -> Result<(), String> {
-    let draw = || -> DrawResult<()> {
-        let columns = panels.len().clamp(1, 2);
-        let rows = panels.len().div_ceil(columns).max(1);
-        let side = WIDTH / columns as u32;
-        let size = (WIDTH, 40 + side * rows as u32);
-        let (root, areas) = canvas(path, size, title, (rows, columns))?;
-        for ((panel_title, series), area) in panels.iter().zip(areas) {
+    let columns = panels.len().clamp(1, 2);
+    let rows = panels.len().div_ceil(columns).max(1);
+    let side = WIDTH / columns as u32;
+    let size = (WIDTH, 40 + side * rows as u32);
+    draw_panels(
+        path,
+        size,
+        title,
+        (rows, columns),
+        panels,
+        |(panel_title, series), area| {
             let (xr, yr) = ranges(series);
             // equal scales: the larger half-span on both axes, about the centre
             let half = 0.5 * (xr.end - xr.start).max(yr.end - yr.start);
@@ -625,7 +624,7 @@ pub fn xy_panels(
                 .iter()
                 .fold(0.0, |m: f64, v| m.max(v.abs()));
             let mut chart = frame(
-                &area,
+                area,
                 panel_title,
                 &keys(series, false)
                     .into_iter()
@@ -654,11 +653,9 @@ pub fn xy_panels(
                 let points = (0..n).step_by(stride).map(|i| (s.x[i], s.y[i]));
                 chart.draw_series(LineSeries::new(points, colour.stroke_width(1)))?;
             }
-        }
-        root.present()?;
-        Ok(())
-    };
-    finish(path, draw())
+            Ok(())
+        },
+    )
 }
 
 /// Stacked panels of bar charts, one per entry (panel title, bars, labelled under the x axis);
@@ -715,31 +712,36 @@ pub fn histogram_panels(
     y_label: &str,
     panels: &[(String, Vec<Bin>)],
 ) -> Result<(), String> {
-    let draw = || -> DrawResult<()> {
-        let (root, areas) = stacked(path, title, panels.len())?;
-        let log_bins = |bins: &[Bin]| -> Vec<(f64, f64, usize)> {
-            bins.iter()
-                .filter(|b| b.lo > 0.0 && b.hi > b.lo && b.hi.is_finite())
-                .map(|b| (b.lo.log10(), b.hi.log10(), b.count))
-                .collect()
-        };
-        // one x range for every panel (they compare), with 3 % margins
-        let all: Vec<_> = panels.iter().flat_map(|(_, b)| log_bins(b)).collect();
-        let lo = all.iter().map(|b| b.0).fold(f64::INFINITY, f64::min);
-        let hi = all.iter().map(|b| b.1).fold(f64::NEG_INFINITY, f64::max);
-        let x_range = if lo < hi {
-            let pad = 0.03 * (hi - lo);
-            lo - pad..hi + pad
-        } else {
-            0.0..1.0
-        };
-        for ((panel_title, bins), area) in panels.iter().zip(areas) {
+    let log_bins = |bins: &[Bin]| -> Vec<(f64, f64, usize)> {
+        bins.iter()
+            .filter(|b| b.lo > 0.0 && b.hi > b.lo && b.hi.is_finite())
+            .map(|b| (b.lo.log10(), b.hi.log10(), b.count))
+            .collect()
+    };
+    // one x range for every panel (they compare), with 3 % margins
+    let all: Vec<_> = panels.iter().flat_map(|(_, b)| log_bins(b)).collect();
+    let lo = all.iter().map(|b| b.0).fold(f64::INFINITY, f64::min);
+    let hi = all.iter().map(|b| b.1).fold(f64::NEG_INFINITY, f64::max);
+    let x_range = if lo < hi {
+        let pad = 0.03 * (hi - lo);
+        lo - pad..hi + pad
+    } else {
+        0.0..1.0
+    };
+    let (size, grid) = (stacked_size(panels.len()), (panels.len().max(1), 1));
+    draw_panels(
+        path,
+        size,
+        title,
+        grid,
+        panels,
+        |(panel_title, bins), area| {
             let bins = log_bins(bins);
             let most = bins.iter().map(|b| b.2).max().unwrap_or(0);
             // counts: at least 0..5, so that the ticks are whole numbers
             let y_range = 0.0..(1.1 * most as f64).max(5.0);
             let mut chart = frame(
-                &area,
+                area,
                 panel_title,
                 &[],
                 AxisSpec::new(x_label, x_range.clone(), Scale::Log10),
@@ -752,11 +754,30 @@ pub fn histogram_panels(
                     COLOURS[0].filled(),
                 )
             }))?;
+            Ok(())
+        },
+    )
+}
+
+/// A canvas of `size` with `title` and a grid of panels, one drawn by `draw` per entry of
+/// `panels`, written as a PNG at `path`.
+fn draw_panels<P>(
+    path: &Path,
+    size: (u32, u32),
+    title: &str,
+    grid: (usize, usize),
+    panels: &[P],
+    mut draw: impl FnMut(&P, &Area) -> DrawResult<()>,
+) -> Result<(), String> {
+    let mut drawn = || -> DrawResult<()> {
+        let (root, areas) = canvas(path, size, title, grid)?;
+        for (panel, area) in panels.iter().zip(&areas) {
+            draw(panel, area)?;
         }
         root.present()?;
         Ok(())
     };
-    finish(path, draw())
+    finish(path, drawn())
 }
 
 /// Axis ranges from the finite data, with 5 % margins; never empty.

@@ -3,10 +3,10 @@
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 
-use fretdyn::simulation::Progress;
+use fretdyn::integrator::simulation::Progress;
 use indicatif::{ProgressBar, ProgressStyle};
 
-/// Observer for [`fretdyn::simulation::run`] that shows a bar after `delay`.
+/// Observer for [`fretdyn::integrator::simulation::run`] that shows a bar after `delay`.
 pub struct Bar {
     start: Instant,
     delay: Duration,

@@ -1,7 +1,7 @@
 //! `fretdyn run`: one case file, or the built-in demo; `fretdyn run --resume DIR` continues a
 //! run that was interrupted; `fretdyn plot DIR` redraws a run's plots.
 //!
-//! Every run is streamed to its folder ([`fretdyn::stream`]): time histories flushed chunk by
+//! Every run is streamed to its folder ([`fretdyn::results::stream`]): time histories flushed chunk by
 //! chunk, impacts as they end, a checkpoint every `checkpoint_seconds` and on Ctrl-C or
 //! SIGTERM, so that a killed run leaves readable results and can be resumed, giving the
 //! results of an uninterrupted run bit for bit. A run holds a lock on its folder: a second
@@ -12,10 +12,10 @@ use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
-use fretdyn::simulation::{Progress, RunResults, Termination};
-use fretdyn::stream::{StreamObserver, StreamSettings};
-use fretdyn::verification::V1;
+use fretdyn::integrator::simulation::{Progress, RunResults, Termination};
+use fretdyn::results::stream::{StreamObserver, StreamSettings};
 use ndarray::{Array3, Ix3};
 use ndarray_npy::NpzReader;
 use serde_json::json;
@@ -59,7 +59,7 @@ pub fn main(case: Option<&Path>, resume: Option<&Path>, options: &Options) -> Re
                 .unwrap_or_else(|| default_dir(&case.title, path));
             let fingerprint = fingerprint_of(path)?;
             // bad input is refused before anything is written
-            fretdyn::simulation::Simulation::check(&case.model, &case.settings)
+            fretdyn::integrator::simulation::Simulation::check(&case.model, &case.settings)
                 .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
             check_disk(&case, path, &dir)?;
             std::fs::create_dir_all(&dir).map_err(|e| {
@@ -149,11 +149,11 @@ fn lock(dir: &Path) -> Result<FolderLock, Failure> {
 }
 
 /// The time histories a streamed run writes, bytes: its samples (`steps / output.every + 1`)
-/// times [`fretdyn::recorder::Recorder::bytes_per_sample`], plus the headers of the files.
+/// times [`fretdyn::results::recorder::Recorder::bytes_per_sample`], plus the headers of the files.
 fn series_bytes(case: &Case) -> u64 {
     let s = &case.settings;
     let samples = (s.steps / s.output_every.max(1)).saturating_add(1);
-    let per_sample = fretdyn::recorder::Recorder::bytes_per_sample(
+    let per_sample = fretdyn::results::recorder::Recorder::bytes_per_sample(
         case.model.basis.modes(),
         case.model.contacts.len(),
     );
@@ -185,7 +185,7 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
         return Ok(());
     };
     let needed = series_bytes(case);
-    let size = fretdyn::recorder::human_bytes;
+    let size = fretdyn::results::recorder::human_bytes;
     if needed > free {
         let raise = needed.div_ceil(free.max(1) / 2 + 1).max(2);
         return Err(Failure::input(format!(
@@ -213,7 +213,7 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
 fn fingerprint_of(path: &Path) -> Result<u64, Failure> {
     let bytes =
         std::fs::read(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
-    Ok(fretdyn::stream::fnv1a(&bytes))
+    Ok(fretdyn::results::stream::fnv1a(&bytes))
 }
 
 fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
@@ -229,7 +229,7 @@ fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
         })?;
     let path = PathBuf::from(info["case_file"].as_str().unwrap_or_default());
     let _lock = lock(dir)?;
-    if !dir.join(fretdyn::stream::CHECKPOINT_FILE).exists() {
+    if !dir.join(fretdyn::results::stream::CHECKPOINT_FILE).exists() {
         return Err(Failure::input(format!(
             "{}: the run stopped before its first checkpoint, there is nothing to resume; start it again: fretdyn run {} -o {}",
             dir.display(),
@@ -283,14 +283,14 @@ impl StreamObserver for Observer<'_> {
     }
 
     fn checkpoint(&mut self, partial: &RunResults) {
-        let summary = fretdyn::output::summary(self.case, partial);
+        let summary = fretdyn::results::output::summary(self.case, partial);
         // a failure here is reported by the final write
-        let _ = fretdyn::output::write_summary(self.dir, &summary);
+        let _ = fretdyn::results::output::write_summary(self.dir, &summary);
     }
 
     fn finished(&mut self, results: &RunResults) -> fretdyn::Result<()> {
-        let summary = fretdyn::output::summary(self.case, results);
-        fretdyn::output::write_summary(self.dir, &summary).map(|_| ())
+        let summary = fretdyn::results::output::summary(self.case, results);
+        fretdyn::results::output::write_summary(self.dir, &summary).map(|_| ())
     }
 }
 
@@ -315,7 +315,7 @@ pub fn run_and_write(
         dir,
     };
     let results = if resume {
-        fretdyn::stream::resume(
+        fretdyn::results::stream::resume(
             &case.model,
             &case.settings,
             dir,
@@ -324,7 +324,7 @@ pub fn run_and_write(
             &mut observer,
         )
     } else {
-        fretdyn::stream::run(
+        fretdyn::results::stream::run(
             &case.model,
             &case.settings,
             dir,
@@ -339,7 +339,7 @@ pub fn run_and_write(
             // a failed run (a full disk): what was written up to the last checkpoint stays
             fretdyn::Error::Io { .. } => Failure::failed(format!(
                 "{source}: {e}{}",
-                if dir.join(fretdyn::stream::CHECKPOINT_FILE).exists() {
+                if dir.join(fretdyn::results::stream::CHECKPOINT_FILE).exists() {
                     format!(
                         "; once fixed (room on the disk), continue the run with: fretdyn run --resume {}",
                         dir.display()
@@ -385,7 +385,7 @@ pub fn run_and_write(
 
 /// Reads `t` and `contact_tangential_force` of a finished run.
 fn read_friction(dir: &Path) -> Result<(Vec<f64>, Array3<f64>), Failure> {
-    let path = dir.join(fretdyn::stream::RESULTS_FILE);
+    let path = dir.join(fretdyn::results::stream::RESULTS_FILE);
     let err = |e: &dyn std::fmt::Display| Failure::failed(format!("{}: {e}", path.display()));
     let file = std::fs::File::open(&path).map_err(|e| err(&e))?;
     let mut npz = NpzReader::new(file).map_err(|e| err(&e))?;
@@ -467,14 +467,14 @@ fn demo(options: &Options) -> Result<(), Failure> {
         )?;
     }
     let mut curves = Vec::new();
-    for (label, method) in fretdyn::verification::methods(&[1e6]) {
+    for (label, method) in fretdyn::apps::verification::methods(&[1e6]) {
         let slug = label.split_whitespace().next().unwrap_or("run").to_string();
         let case = v1.case(&format!("V1a {label}"), method);
         let sub = dir.join(&slug);
         std::fs::create_dir_all(&sub).map_err(|e| {
             Failure::failed(format!("{}: cannot create the folder: {e}", sub.display()))
         })?;
-        let fingerprint = fretdyn::stream::fnv1a(case.title.as_bytes());
+        let fingerprint = fretdyn::results::stream::fnv1a(case.title.as_bytes());
         let _lock = lock(&sub)?;
         run_and_write(&case, "demo", &sub, options, fingerprint, false)?;
         let (t, f) = read_friction(&sub)?;

@@ -1,11 +1,11 @@
-//! `fretdyn sweep STUDY.toml`: a parametric or Monte-Carlo study ([`fretdyn::study`]) on every
+//! `fretdyn sweep STUDY.toml`: a parametric or Monte-Carlo study ([`fretdyn::apps::study`]) on every
 //! core, one row per finished run in `study.csv`, a progress bar, and a plot of a statistic
 //! against a parameter. Killed midway, run again: the finished rows are kept and skipped.
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use fretdyn::study::Study;
+use fretdyn::apps::study::Study;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Failure;
@@ -262,7 +262,7 @@ fn parameter_value(key: &str, value: &str) -> String {
 }
 
 /// Readable name and unit of a statistic of the study table
-/// ([`fretdyn::study::TABLE_STATISTICS`]); another: its key with spaces, no unit.
+/// ([`fretdyn::apps::study::TABLE_STATISTICS`]); another: its key with spaces, no unit.
 fn statistic_name(statistic: &str) -> (String, &'static str) {
     match known_statistic(statistic) {
         Some((name, unit)) => (name.to_string(), unit),
@@ -331,7 +331,7 @@ mod tests {
             "maximum normal force (N)"
         );
         // every statistic of the table has a readable name
-        for s in fretdyn::study::TABLE_STATISTICS {
+        for s in fretdyn::apps::study::TABLE_STATISTICS {
             assert!(known_statistic(s).is_some(), "{s}");
         }
     }

@@ -3,9 +3,9 @@
 
 use std::path::Path;
 
-use fretdyn::simulation::{RunResults, simulate};
-use fretdyn::tangential::{GaussSeidelSettings, StickVelocity, TangentialMethod};
-use fretdyn::verification::{Check, V1, V1Measurements, checks, measure, methods};
+use fretdyn::apps::verification::{Check, V1, V1Measurements, checks, measure, methods};
+use fretdyn::contact::tangential::{GaussSeidelSettings, StickVelocity, TangentialMethod};
+use fretdyn::integrator::simulation::{RunResults, simulate};
 use serde_json::json;
 
 use crate::Failure;

@@ -272,14 +272,14 @@ fn modes_prints_the_table_and_writes_basis_and_picture() {
     for f in ["basis.npz", "mode_shapes.png"] {
         assert!(s.0.join("m").join(f).is_file(), "{f}");
     }
-    let back = fretdyn::output::read_basis_npz(&s.0.join("m/basis.npz")).unwrap();
+    let back = fretdyn::structure::basis_file::read_basis_npz(&s.0.join("m/basis.npz")).unwrap();
     assert_eq!(back.basis.modes(), 12);
     assert_eq!(back.basis.points.len(), 2);
 }
 
 /// Step of the last checkpoint in a run folder, if there is one.
 fn checkpoint_step(dir: &Path) -> Option<u64> {
-    fretdyn::stream::checkpoint_step(dir).ok()
+    fretdyn::results::stream::checkpoint_step(dir).ok()
 }
 
 fn npz_f64(dir: &Path, key: &str) -> ndarray::ArrayD<f64> {

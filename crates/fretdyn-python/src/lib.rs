@@ -146,7 +146,7 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
     let c = &case.inner;
     let s = &c.settings;
     let samples = (s.steps / s.output_every.max(1)).saturating_add(1);
-    fretdyn::recorder::Recorder::check_memory(
+    fretdyn::results::recorder::Recorder::check_memory(
         samples,
         c.model.basis.modes(),
         c.model.contacts.len(),
@@ -156,7 +156,7 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
     let mut interrupted = None;
     let results = py
         .detach(|| {
-            fretdyn::simulation::run(&c.model, &c.settings, |_| {
+            fretdyn::integrator::simulation::run(&c.model, &c.settings, |_| {
                 // back in the interpreter for a moment, every 1024 steps, for Ctrl-C
                 match Python::attach(|py| py.check_signals()) {
                     Ok(()) => ControlFlow::Continue(()),
@@ -215,19 +215,19 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
         "contact_status",
         PyArray1::from_vec(py, status).reshape(r.status.shape().to_vec())?,
     )?;
-    let summary = fretdyn::output::summary(c, &results);
+    let summary = fretdyn::results::output::summary(c, &results);
     out.set_item("summary_json", summary.to_string())?;
     if matches!(
         results.termination,
-        fretdyn::simulation::Termination::Stopped { .. }
+        fretdyn::integrator::simulation::Termination::Stopped { .. }
     ) {
         return Err(PyKeyboardInterrupt::new_err("the run was interrupted"));
     }
     Ok(out)
 }
 
-fn study(path: &Path) -> PyResult<fretdyn::study::Study> {
-    fretdyn::study::Study::from_file(path).map_err(|e| FretdynError::new_err(e.in_file(path)))
+fn study(path: &Path) -> PyResult<fretdyn::apps::study::Study> {
+    fretdyn::apps::study::Study::from_file(path).map_err(|e| FretdynError::new_err(e.in_file(path)))
 }
 
 /// Number of runs of a study.

@@ -1,10 +1,12 @@
-//! The model: modal basis, contacts, loads and initial state — everything a run needs except
-//! the numerical settings.
+//! **Stage 5 — the model.** What enters: the modal basis ([`crate::structure`]), the contacts
+//! ([`crate::contact`]) and the loads ([`crate::loads`]), as the case built them. What leaves:
+//! the [`Model`] the integrator steps — modal basis, contacts, loads and initial state,
+//! everything a run needs except the numerical settings (THEORY §1, §2).
 
 use crate::contact::Contact;
 use crate::error::{Error, Result};
-use crate::load::{BaseAcceleration, ModalLoad, PointLoad};
-use crate::modal::ModalBasis;
+use crate::loads::{BaseAcceleration, ModalLoad, PointLoad};
+use crate::structure::modal::ModalBasis;
 
 /// Initial modal state `q(0)`, `q̇(0)`.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,7 +57,7 @@ pub struct Model {
     /// Loads given on the modes (modal forces, line loads along a tube).
     pub modal_loads: Vec<ModalLoad>,
     /// Random turbulence loads.
-    pub turbulence: Vec<crate::load::TurbulentLoad>,
+    pub turbulence: Vec<crate::loads::TurbulentLoad>,
     /// Uniform acceleration of the base, if any (displacements are then relative to it).
     pub base_acceleration: Option<BaseAcceleration>,
     /// Initial state.
@@ -83,7 +85,10 @@ impl Model {
 
     /// A model in physical coordinates: `points` give, for each named point, the 3 × n rows
     /// that pick its displacement out of the n degrees of freedom.
-    pub fn physical(matrices: PhysicalMatrices, points: Vec<crate::modal::Point>) -> Self {
+    pub fn physical(
+        matrices: PhysicalMatrices,
+        points: Vec<crate::structure::modal::Point>,
+    ) -> Self {
         let n = matrices.mass.nrows();
         let mut model = Self::new(ModalBasis {
             omega: vec![0.0; n],

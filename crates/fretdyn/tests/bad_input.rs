@@ -6,15 +6,15 @@
 use std::path::{Path, PathBuf};
 
 use fretdyn::Error;
+use fretdyn::apps::study::Study;
 use fretdyn::case::Case;
+use fretdyn::contact::friction::Coulomb;
+use fretdyn::contact::obstacle::{Obstacle, Plane};
+use fretdyn::contact::tangential::{GaussSeidelSettings, TangentialMethod};
 use fretdyn::contact::{Contact, NormalLaw};
-use fretdyn::friction::Coulomb;
-use fretdyn::modal::ModalBasis;
+use fretdyn::integrator::stability::{checked_stable_time_step, stable_time_step};
 use fretdyn::model::Model;
-use fretdyn::obstacle::{Obstacle, Plane};
-use fretdyn::stability::{checked_stable_time_step, stable_time_step};
-use fretdyn::study::Study;
-use fretdyn::tangential::{GaussSeidelSettings, TangentialMethod};
+use fretdyn::structure::modal::ModalBasis;
 use nalgebra::Vector3;
 
 const V1A: &str = include_str!("../../../examples/v1a_oblique_impact.toml");
@@ -600,7 +600,7 @@ fn an_initial_state_whose_energy_overflows_is_refused() {
         Path::new("."),
     )
     .expect("a finite velocity is a valid case file");
-    match fretdyn::simulation::simulate(&case.model, &case.settings) {
+    match fretdyn::integrator::simulation::simulate(&case.model, &case.settings) {
         Err(Error::Invalid { field, message }) => {
             assert_eq!(field, "initial");
             assert!(message.contains("units"), "{message}");

@@ -1,9 +1,9 @@
 //! Beam finite elements and modal analysis against the analytic Euler–Bernoulli frequencies.
 
-use fretdyn::beam::{
+use fretdyn::structure::beam::{
     BeamModel, Fluid, Material, Mesh, Restraint, Theory, Tube, TubeSection, clamped, pinned,
 };
-use fretdyn::eigen::{ModeSelection, lowest_modes, orthonormality_error};
+use fretdyn::structure::eigen::{ModeSelection, lowest_modes, orthonormality_error};
 use nalgebra::Vector3;
 
 fn tube(theory: Theory, fluid: Fluid) -> Tube {

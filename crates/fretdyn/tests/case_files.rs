@@ -5,11 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use fretdyn::Error;
+use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
-use fretdyn::recorder::Recorder;
-use fretdyn::simulation::simulate;
-use fretdyn::tangential::{GaussSeidelSettings, TangentialMethod};
-use fretdyn::verification::V1;
+use fretdyn::contact::tangential::{GaussSeidelSettings, TangentialMethod};
+use fretdyn::integrator::simulation::simulate;
+use fretdyn::results::recorder::Recorder;
 
 /// V1a (THEORY §6) as a case file. The incoming velocity is written with Rust's shortest
 /// round-trip formatting of the same expressions `V1::model` evaluates, so it is exact.
@@ -113,7 +113,7 @@ fn v1a_case_file_runs_bit_for_bit_like_the_case_built_in_code() {
     let b = simulate(&in_code.model, &in_code.settings).unwrap();
     assert_same_recorder(&a.recorder, &b.recorder);
     // and it is V1a: it sticks and leaves with no tangential velocity (THEORY §6)
-    let m = fretdyn::verification::measure(&V1::reference(20.0), &a);
+    let m = fretdyn::apps::verification::measure(&V1::reference(20.0), &a);
     assert!(m.leaving_tangential_speed <= 1e-9, "{m:?}");
 }
 
@@ -154,7 +154,7 @@ fn method_names_and_options_are_read() {
     let case = parse(&penalty).unwrap();
     assert_eq!(
         case.settings.method,
-        TangentialMethod::Penalty(fretdyn::tangential::PenaltySettings {
+        TangentialMethod::Penalty(fretdyn::contact::tangential::PenaltySettings {
             stiffness: 1e6,
             damping: 2000.0
         })
@@ -162,7 +162,7 @@ fn method_names_and_options_are_read() {
     let full = replace_once(&text, "\"half_step\"", "\"full_step\"");
     assert_eq!(
         parse(&full).unwrap().settings.stick_velocity,
-        fretdyn::tangential::StickVelocity::FullStep
+        fretdyn::contact::tangential::StickVelocity::FullStep
     );
     let active = replace_once(
         &text,
@@ -389,7 +389,7 @@ file = "no_such_basis.npz"
 fn modal_basis_npz_round_trip() {
     let dir = TempDir::new("roundtrip");
     let stations = vec![("A".to_string(), 0.3), ("support_1".to_string(), 1.1)];
-    let beam = fretdyn::modal::PinnedBeam {
+    let beam = fretdyn::structure::modal::PinnedBeam {
         length: 2.0,
         bending_stiffness: 498.0,
         mass_per_length: 1.0,
@@ -398,12 +398,14 @@ fn modal_basis_npz_round_trip() {
         axial_modes: 2,
         damping_ratio: 0.02,
     };
-    let mut basis = fretdyn::modal::ModalBasis::pinned_beam(&beam, &stations).unwrap();
+    let mut basis = fretdyn::structure::modal::ModalBasis::pinned_beam(&beam, &stations).unwrap();
     basis.damping_ratio[1] = 0.05;
     basis.points[1].coords = nalgebra::Vector3::new(1.1, -0.25, 3.5);
     let path = dir.0.join("basis.npz");
-    fretdyn::output::write_basis_npz(&path, &basis).unwrap();
-    let back = fretdyn::output::read_basis_npz(&path).unwrap().basis;
+    fretdyn::structure::basis_file::write_basis_npz(&path, &basis).unwrap();
+    let back = fretdyn::structure::basis_file::read_basis_npz(&path)
+        .unwrap()
+        .basis;
     assert_eq!(
         back.points, basis.points,
         "rows and coords are stored as float64"
@@ -443,7 +445,7 @@ fn npz_rows_of_the_wrong_shape_are_refused_with_the_expected_shape() {
             .unwrap();
         npz.finish().unwrap();
     }
-    match fretdyn::output::read_basis_npz(&path) {
+    match fretdyn::structure::basis_file::read_basis_npz(&path) {
         Err(Error::Npz { path: p, message }) => {
             assert_eq!(p, path);
             assert!(message.contains("rows_A"), "{message}");
@@ -482,7 +484,7 @@ fn npz_mass_normalisation_is_checked_when_the_mass_matrix_is_given() {
         )
         .unwrap();
         npz.finish().unwrap();
-        let result = fretdyn::output::read_basis_npz(&path);
+        let result = fretdyn::structure::basis_file::read_basis_npz(&path);
         (dir, result)
     };
     let (_d, exact) = write("exact", 1.0);

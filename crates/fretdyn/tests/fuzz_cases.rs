@@ -18,7 +18,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use fretdyn::case::Case;
-use fretdyn::simulation::simulate;
+use fretdyn::integrator::simulation::simulate;
 use toml::Value;
 
 /// SplitMix64: a seeded stream of pseudo-random numbers (reproducible failures).
@@ -277,7 +277,7 @@ fn check(text: String, base: PathBuf) -> Outcome {
     if rec.position.iter().any(|x| !x.is_finite()) {
         bad.push("results.position".into());
     }
-    let summary = fretdyn::output::summary(&case, &results);
+    let summary = fretdyn::results::output::summary(&case, &results);
     // a model without stiffness (free masses, no contact) has no stability limit: its
     // `stable_dt` is ∞, written as null
     let unbounded = results.stable_dt == f64::INFINITY;

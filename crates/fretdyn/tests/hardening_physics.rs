@@ -16,19 +16,19 @@ use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 use fretdyn::case::Case;
-use fretdyn::contact::{Contact, NormalLaw};
-use fretdyn::friction::Coulomb;
-use fretdyn::load::{PointLoad, TimeHistory};
-use fretdyn::modal::ModalBasis;
-use fretdyn::model::Model;
-use fretdyn::motion::Motion;
-use fretdyn::obstacle::{Obstacle, Plane};
-use fretdyn::simulation::{RunResults, RunSettings, Termination, simulate};
-use fretdyn::statistics::StatisticsSettings;
-use fretdyn::stream::{self, ProgressOnly, StreamSettings};
-use fretdyn::tangential::{
+use fretdyn::contact::friction::Coulomb;
+use fretdyn::contact::motion::Motion;
+use fretdyn::contact::obstacle::{Obstacle, Plane};
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
+use fretdyn::contact::{Contact, NormalLaw};
+use fretdyn::integrator::simulation::{RunResults, RunSettings, Termination, simulate};
+use fretdyn::loads::{PointLoad, TimeHistory};
+use fretdyn::model::Model;
+use fretdyn::results::statistics::StatisticsSettings;
+use fretdyn::results::stream::{self, ProgressOnly, StreamSettings};
+use fretdyn::structure::modal::ModalBasis;
 use nalgebra::Vector3;
 
 fn lagrange_methods() -> [(&'static str, TangentialMethod); 2] {
@@ -493,7 +493,7 @@ every = 1
             assert_eq!(contact.as_deref(), culprit, "{label} {how}");
             assert_eq!(*time, *step as f64 * case.settings.dt, "{label} {how}");
             assert_eq!(r.steps, step - 1, "{label} {how}: the steps kept");
-            let summary = fretdyn::output::summary(&case, r);
+            let summary = fretdyn::results::output::summary(&case, r);
             let mut nulls = Vec::new();
             find_nulls(&summary, "summary", &mut nulls);
             // the one null allowed: no contact to name

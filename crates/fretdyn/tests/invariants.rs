@@ -2,11 +2,11 @@
 //! invariance of the isotropic friction law, energy conservation of the elastic frictionless
 //! impact, friction dissipation, and mass/stiffness scaling.
 
-use fretdyn::simulation::{RunResults, Termination, simulate};
-use fretdyn::tangential::{
+use fretdyn::apps::verification::{V1, measure};
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
-use fretdyn::verification::{V1, measure};
+use fretdyn::integrator::simulation::{RunResults, Termination, simulate};
 use nalgebra::Vector3;
 
 fn methods() -> Vec<(&'static str, TangentialMethod)> {

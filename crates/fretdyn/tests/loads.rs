@@ -7,8 +7,8 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use fretdyn::case::Case;
-use fretdyn::load::TimeHistory;
-use fretdyn::spatial_correlation::line_covariance;
+use fretdyn::loads::TimeHistory;
+use fretdyn::loads::spatial_correlation::line_covariance;
 
 fn tube_case(extra: &str) -> String {
     format!(
@@ -142,12 +142,12 @@ fn tables_interpolate_linearly_and_hold_their_ends_from_every_source() {
 #[test]
 fn sums_of_sines_add_their_terms() {
     let h = TimeHistory::Sines(vec![
-        fretdyn::load::Sine {
+        fretdyn::loads::Sine {
             amplitude: 2.0,
             frequency_hz: 3.0,
             phase: 0.5,
         },
-        fretdyn::load::Sine {
+        fretdyn::loads::Sine {
             amplitude: -1.0,
             frequency_hz: 7.5,
             phase: 0.0,

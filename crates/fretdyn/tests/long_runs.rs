@@ -6,9 +6,9 @@ use std::ops::ControlFlow;
 use std::path::Path;
 
 use fretdyn::case::Case;
-use fretdyn::simulation::{Progress, RunResults, Termination, simulate};
-use fretdyn::statistics::StatisticsSettings;
-use fretdyn::stream::{self, ProgressOnly, StreamObserver, StreamSettings};
+use fretdyn::integrator::simulation::{Progress, RunResults, Termination, simulate};
+use fretdyn::results::statistics::StatisticsSettings;
+use fretdyn::results::stream::{self, ProgressOnly, StreamObserver, StreamSettings};
 use ndarray::{ArrayD, IxDyn};
 use ndarray_npy::NpzReader;
 

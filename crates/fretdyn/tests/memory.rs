@@ -8,10 +8,10 @@ use std::cell::Cell;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use fretdyn::apps::study::{Combine, Study};
 use fretdyn::case::Case;
-use fretdyn::recorder::Recorder;
-use fretdyn::simulation::simulate;
-use fretdyn::study::{Combine, Study};
+use fretdyn::integrator::simulation::simulate;
+use fretdyn::results::recorder::Recorder;
 
 struct Counting;
 
@@ -109,7 +109,7 @@ fn a_history_larger_than_the_memory_is_refused_and_a_study_keeps_none() {
         bytes_row < history / 100,
         "the study's run allocated {bytes_row} bytes for {history} bytes of histories"
     );
-    let (stats, _) = bytes_allocated(|| fretdyn::study::run_statistics(&case).unwrap());
+    let (stats, _) = bytes_allocated(|| fretdyn::apps::study::run_statistics(&case).unwrap());
     assert_eq!(stats.contacts, full.contacts);
     assert_eq!(stats.solver, full.solver);
     assert_eq!(stats.energy, full.energy);

@@ -3,16 +3,16 @@
 //! matrices) and on the modal coordinates of its mass-normalised modes give the same contact
 //! forces and point displacements, for every tangential method.
 
-use fretdyn::contact::{Contact, NormalLaw};
-use fretdyn::friction::Coulomb;
-use fretdyn::load::{PointLoad, TimeHistory};
-use fretdyn::modal::{ModalBasis, Point};
-use fretdyn::model::{Model, PhysicalMatrices};
-use fretdyn::obstacle::{Obstacle, Plane};
-use fretdyn::simulation::{RunResults, RunSettings, simulate};
-use fretdyn::tangential::{
+use fretdyn::contact::friction::Coulomb;
+use fretdyn::contact::obstacle::{Obstacle, Plane};
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
+use fretdyn::contact::{Contact, NormalLaw};
+use fretdyn::integrator::simulation::{RunResults, RunSettings, simulate};
+use fretdyn::loads::{PointLoad, TimeHistory};
+use fretdyn::model::{Model, PhysicalMatrices};
+use fretdyn::structure::modal::{ModalBasis, Point};
 use nalgebra::{DMatrix, DVector, Vector3};
 
 /// Tiny deterministic generator in [-1, 1).

@@ -1,17 +1,17 @@
 //! Contacts on the tube surface (rotations in the slip velocity), obstacles that move, and a
 //! base acceleration, against closed-form solutions and against each other (THEORY §3).
 
-use fretdyn::contact::{Contact, NormalLaw};
-use fretdyn::friction::Coulomb;
-use fretdyn::load::{BaseAcceleration, PointLoad, TimeHistory};
-use fretdyn::modal::{ModalBasis, Point};
-use fretdyn::model::Model;
-use fretdyn::motion::Motion;
-use fretdyn::obstacle::{Circle, Obstacle, Plane};
-use fretdyn::simulation::{RunResults, RunSettings, simulate};
-use fretdyn::tangential::{
+use fretdyn::contact::friction::Coulomb;
+use fretdyn::contact::motion::Motion;
+use fretdyn::contact::obstacle::{Circle, Obstacle, Plane};
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
+use fretdyn::contact::{Contact, NormalLaw};
+use fretdyn::integrator::simulation::{RunResults, RunSettings, simulate};
+use fretdyn::loads::{BaseAcceleration, PointLoad, TimeHistory};
+use fretdyn::model::Model;
+use fretdyn::structure::modal::{ModalBasis, Point};
 use nalgebra::Vector3;
 
 fn settings(method: TangentialMethod, dt: f64, steps: u64) -> RunSettings {

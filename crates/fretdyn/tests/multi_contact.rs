@@ -5,15 +5,15 @@
 
 use std::ops::ControlFlow;
 
-use fretdyn::benchmark::rattling_tube;
-use fretdyn::delassus::{Slot, TangentialProblem};
-use fretdyn::friction::Slide;
-use fretdyn::simulation::{RunResults, Termination, run, simulate};
-use fretdyn::tangential::active_set::{ActiveSet, History, Outcome};
-use fretdyn::tangential::{
+use fretdyn::apps::benchmark::rattling_tube;
+use fretdyn::contact::delassus::{Slot, TangentialProblem};
+use fretdyn::contact::friction::Slide;
+use fretdyn::contact::tangential::active_set::{ActiveSet, History, Outcome};
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, SolverStatistics, TangentialMethod,
     gauss_seidel,
 };
+use fretdyn::integrator::simulation::{RunResults, Termination, run, simulate};
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
 // ---------------------------------------------------------------------------------------------
@@ -730,10 +730,10 @@ fn one_step_problem_with_slow_slip_still_gives_the_coulomb_solution() {
 // ---------------------------------------------------------------------------------------------
 
 fn point_mass_on_plane(mass: f64, kn: f64, gap: f64) -> fretdyn::model::Model {
+    use fretdyn::contact::friction::Coulomb;
+    use fretdyn::contact::obstacle::{Obstacle, Plane};
     use fretdyn::contact::{Contact, NormalLaw};
-    use fretdyn::friction::Coulomb;
-    use fretdyn::modal::ModalBasis;
-    use fretdyn::obstacle::{Obstacle, Plane};
+    use fretdyn::structure::modal::ModalBasis;
     let basis = ModalBasis::point_mass(mass, "m", Vector3::zeros()).unwrap();
     let mut model = fretdyn::model::Model::new(basis);
     model.contacts.push(Contact::new(
@@ -754,7 +754,7 @@ fn stable_time_step_of_a_point_mass_on_a_plane_is_two_over_omega() {
     let model = point_mass_on_plane(m, kn, 0.0);
     let expected = 2.0 / (kn / m).sqrt();
     for method in [gs(), active_set()] {
-        let dt = fretdyn::stability::stable_time_step(&model, &method);
+        let dt = fretdyn::integrator::stability::stable_time_step(&model, &method);
         assert!(
             (dt - expected).abs() <= 1e-12 * expected,
             "{}: {dt} vs {expected}",
@@ -767,7 +767,7 @@ fn stable_time_step_of_a_point_mass_on_a_plane_is_two_over_omega() {
         stiffness: kt,
         damping: 0.0,
     });
-    let dt = fretdyn::stability::stable_time_step(&model, &penalty);
+    let dt = fretdyn::integrator::stability::stable_time_step(&model, &penalty);
     let expected_t = 2.0 / (kt / m).sqrt();
     assert!(
         (dt - expected_t).abs() <= 1e-12 * expected_t,
@@ -780,7 +780,7 @@ fn time_step_above_the_stable_limit_is_refused_with_the_limit_in_the_message() {
     let (m, kn) = (2.5f64, 4e6f64);
     let model = point_mass_on_plane(m, kn, 0.0);
     let limit = 2.0 / (kn / m).sqrt();
-    let settings = fretdyn::simulation::RunSettings {
+    let settings = fretdyn::integrator::simulation::RunSettings {
         dt: 1.01 * limit,
         steps: 10,
         method: gs(),
@@ -807,7 +807,7 @@ fn time_step_above_the_stable_limit_is_refused_with_the_limit_in_the_message() {
 /// with the amplitude of the discrete oscillator, v₀/(ω √(1 − (ωΔt/2)²)) ≈ 5 v₀/ω.
 #[test]
 fn time_step_just_below_the_limit_is_stable() {
-    use fretdyn::load::{PointLoad, TimeHistory};
+    use fretdyn::loads::{PointLoad, TimeHistory};
     let (m, kn) = (2.5f64, 4e6f64);
     let omega = (kn / m).sqrt();
     let preload = 1e-3; // equilibrium penetration, m
@@ -826,7 +826,7 @@ fn time_step_just_below_the_limit_is_stable() {
         .set_initial_from_point(0, Vector3::zeros(), Vector3::new(0.0, 0.0, v0))
         .unwrap();
     let h = 0.98 * 2.0;
-    let settings = fretdyn::simulation::RunSettings {
+    let settings = fretdyn::integrator::simulation::RunSettings {
         dt: h / omega,
         steps: 5000,
         method: gs(),
@@ -860,7 +860,7 @@ fn time_step_just_below_the_limit_is_stable() {
 fn natural_map_residual_ranks_the_solvers() {
     let steps = 20_000;
     let radial = TangentialMethod::GaussSeidel(GaussSeidelSettings {
-        local_solve: fretdyn::friction::LocalSolve::Radial,
+        local_solve: fretdyn::contact::friction::LocalSolve::Radial,
         ..GaussSeidelSettings::default()
     });
     let mut report = Vec::new();

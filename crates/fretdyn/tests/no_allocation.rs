@@ -6,11 +6,11 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use fretdyn::benchmark::rattling_tube;
-use fretdyn::simulation::simulate;
-use fretdyn::tangential::{
+use fretdyn::apps::benchmark::rattling_tube;
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, TangentialMethod,
 };
+use fretdyn::integrator::simulation::simulate;
 
 struct Counting;
 
@@ -51,8 +51,8 @@ fn allocations_of_run(method: TangentialMethod, steps: u64, turbulence: bool) ->
         // 3 random channels on the modes, sampled at 80 kHz: 20 000 steps cross several
         // blocks of the generator
         let p = case.model.basis.modes();
-        case.model.turbulence.push(fretdyn::load::TurbulentLoad {
-            spectrum: fretdyn::turbulence::Spectrum::Table {
+        case.model.turbulence.push(fretdyn::loads::TurbulentLoad {
+            spectrum: fretdyn::loads::turbulence::Spectrum::Table {
                 frequency_hz: vec![5e3, 1e4],
                 psd: vec![1.0, 1.0],
             },
@@ -61,8 +61,9 @@ fn allocations_of_run(method: TangentialMethod, steps: u64, turbulence: bool) ->
             f_max: 1e4,
         });
         let load = &case.model.turbulence[0];
-        let g = fretdyn::turbulence::RandomChannels::new(&load.spectrum, 3, 1, load.f_max, "t")
-            .unwrap();
+        let g =
+            fretdyn::loads::turbulence::RandomChannels::new(&load.spectrum, 3, 1, load.f_max, "t")
+                .unwrap();
         let samples = 20_000.0 * case.settings.dt * g.sample_rate();
         assert!(
             samples > 2.0 * g.block_length() as f64,

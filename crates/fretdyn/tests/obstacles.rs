@@ -1,15 +1,15 @@
 //! The obstacles of THEORY §3 beyond the plane: a drilled hole (point–circle) and a pair of
 //! flat bars (bi-plane), against analytic solutions and an equivalent model.
 
-use fretdyn::contact::{Contact, NormalLaw};
-use fretdyn::friction::Coulomb;
-use fretdyn::modal::ModalBasis;
-use fretdyn::model::Model;
-use fretdyn::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
-use fretdyn::simulation::{RunSettings, simulate};
-use fretdyn::tangential::{
+use fretdyn::contact::friction::Coulomb;
+use fretdyn::contact::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
+use fretdyn::contact::{Contact, NormalLaw};
+use fretdyn::integrator::simulation::{RunSettings, simulate};
+use fretdyn::model::Model;
+use fretdyn::structure::modal::ModalBasis;
 use nalgebra::{Vector2, Vector3};
 
 fn settings(method: TangentialMethod, dt: f64, steps: u64, every: u64) -> RunSettings {
@@ -176,8 +176,8 @@ fn obstacle_input_errors() {
 /// forces; the Lagrange methods give the single plane's motion and count the singular steps.
 #[test]
 fn two_coincident_planes_are_one_plane_of_double_stiffness() {
-    use fretdyn::load::{PointLoad, TimeHistory};
-    use fretdyn::simulation::Termination;
+    use fretdyn::integrator::simulation::Termination;
+    use fretdyn::loads::{PointLoad, TimeHistory};
     let model = |planes: &[(f64, &str)]| {
         let mut m = Model::new(ModalBasis::point_mass(1.0, "mass", Vector3::zeros()).unwrap());
         for (kn, name) in planes {

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use fretdyn::simulation::simulate;
-use fretdyn::study::Study;
+use fretdyn::apps::study::Study;
+use fretdyn::integrator::simulation::simulate;
 
 fn write_study(dir: &Path, combine: &str) -> std::path::PathBuf {
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");

@@ -5,11 +5,11 @@
 use std::path::Path;
 
 use fretdyn::case::Case;
-use fretdyn::model::Model;
-use fretdyn::simulation::{RunResults, RunSettings, simulate};
-use fretdyn::tangential::{
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
+use fretdyn::integrator::simulation::{RunResults, RunSettings, simulate};
+use fretdyn::model::Model;
 
 /// A clamped–clamped 1 m tube of 10 elements (54 free DOFs, all kept), one mid-span contact
 /// on the tube surface (rotations enter its rows), a second one on the side, Rayleigh damping.
@@ -236,8 +236,8 @@ fn compare_all_modes(text: &str, methods: &[TangentialMethod]) {
             for i in 0..ra.len() {
                 let qa: Vec<f64> = ra.q.row(i).to_vec();
                 let qb: Vec<f64> = rb.q.row(i).to_vec();
-                let ua = fretdyn::modal::recombine(&pa.rows, &qa);
-                let ub = fretdyn::modal::recombine(&pb.rows, &qb);
+                let ua = fretdyn::structure::modal::recombine(&pa.rows, &qa);
+                let ub = fretdyn::structure::modal::recombine(&pb.rows, &qb);
                 scale = scale.max(ua.amax());
                 du = du.max((ua - ub).amax());
             }

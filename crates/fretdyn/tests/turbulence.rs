@@ -20,8 +20,8 @@ use std::cell::Cell;
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use fretdyn::spatial_correlation::correlated_factor;
-use fretdyn::turbulence::{GeneratorSettings, RandomChannels, Spectrum};
+use fretdyn::loads::spatial_correlation::correlated_factor;
+use fretdyn::loads::turbulence::{GeneratorSettings, RandomChannels, Spectrum};
 use nalgebra::DMatrix;
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex;

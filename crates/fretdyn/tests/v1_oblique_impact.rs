@@ -6,9 +6,9 @@
 //! time histories and the analytic formulas of §6, so that they do not depend on
 //! `verification::measure`.
 
-use fretdyn::simulation::{RunResults, simulate};
-use fretdyn::tangential::{GaussSeidelSettings, StickVelocity, TangentialMethod};
-use fretdyn::verification::{Check, V1, V1Measurements, checks, measure, methods};
+use fretdyn::apps::verification::{Check, V1, V1Measurements, checks, measure, methods};
+use fretdyn::contact::tangential::{GaussSeidelSettings, StickVelocity, TangentialMethod};
+use fretdyn::integrator::simulation::{RunResults, simulate};
 
 const PENALTY_KT: [f64; 3] = [1e5, 1e6, 1e7];
 
@@ -20,7 +20,7 @@ fn run(v1: &V1, method: TangentialMethod, stick: StickVelocity) -> RunResults {
     let results = simulate(&v1.model(), &v1.settings(method, stick)).expect("V1 runs");
     assert_eq!(
         results.termination,
-        fretdyn::simulation::Termination::Completed
+        fretdyn::integrator::simulation::Termination::Completed
     );
     results
 }

@@ -5,18 +5,18 @@
 
 use std::f64::consts::TAU;
 
-use fretdyn::contact::{Contact, NormalLaw};
-use fretdyn::friction::Coulomb;
-use fretdyn::load::{PointLoad, TimeHistory};
-use fretdyn::modal::{ModalBasis, Point};
-use fretdyn::model::Model;
-use fretdyn::motion::Motion;
-use fretdyn::obstacle::{Obstacle, Plane};
-use fretdyn::simulation::{RunResults, RunSettings, simulate};
-use fretdyn::statistics::StatisticsSettings;
-use fretdyn::tangential::{
+use fretdyn::contact::friction::Coulomb;
+use fretdyn::contact::motion::Motion;
+use fretdyn::contact::obstacle::{Obstacle, Plane};
+use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
 };
+use fretdyn::contact::{Contact, NormalLaw};
+use fretdyn::integrator::simulation::{RunResults, RunSettings, simulate};
+use fretdyn::loads::{PointLoad, TimeHistory};
+use fretdyn::model::Model;
+use fretdyn::results::statistics::StatisticsSettings;
+use fretdyn::structure::modal::{ModalBasis, Point};
 use nalgebra::Vector3;
 
 /// A 1 kg point mass free in x, y, z (three rigid modes, unit rows).

@@ -1,0 +1,11 @@
+//! **Applications** built on the stages, apart from the physics: they run cases, they add no
+//! equation.
+//!
+//! - [`study`]: parameter studies — one case file, a grid of values, one run per point;
+//! - [`verification`]: the verification cases against closed forms (THEORY §6,
+//!   `docs/VERIFICATION.md`);
+//! - [`benchmark`]: the step-speed benchmark case (`docs/PERFORMANCE.md`).
+
+pub mod benchmark;
+pub mod study;
+pub mod verification;

@@ -1,0 +1,196 @@
+//! **Stage 1 — the case.** What enters: a TOML case file (every key is documented in
+//! `examples/*.toml`; unknown keys are errors). What leaves: the typed [`Model`] and
+//! [`RunSettings`] of a [`Case`], built by the stages that follow (THEORY §1–§10 for what
+//! each key means).
+//!
+//! The schema is split by section, each file holding its sections' types and the build of
+//! the model from them:
+//! - `structure`: `[structure]` and `[initial]`;
+//! - `contacts`: `[[contacts]]`;
+//! - `loads`: `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]`, `[[turbulence]]`,
+//!   `[base_excitation]`;
+//! - `settings`: `[time]`, `[tangential]`, `[output]`, `[statistics]`.
+//!
+//! This module reads the file, holds the top-level schema (`CaseFile`) and builds the
+//! sections in order.
+
+mod contacts;
+mod loads;
+mod settings;
+mod structure;
+
+pub use structure::TubeModel;
+
+use contacts::ContactSection;
+use loads::{BaseSection, LineLoadSection, LoadSection, ModalLoadSection, TurbulenceSection};
+use settings::{OutputSection, StatisticsSection, TangentialSection, TimeSection};
+use structure::{InitialSection, StructureSection};
+
+use std::path::Path;
+
+use nalgebra::Vector3;
+use serde::Deserialize;
+
+use crate::error::{Error, Result};
+use crate::integrator::simulation::RunSettings;
+use crate::model::Model;
+
+/// A parsed, validated case.
+#[derive(Debug, Clone)]
+pub struct Case {
+    /// Title (from the file, or its stem).
+    pub title: String,
+    /// The model.
+    pub model: Model,
+    /// Numerical settings.
+    pub settings: RunSettings,
+    /// The case as read, echoed in `summary.json`.
+    pub echo: serde_json::Value,
+    /// Accepted but doubtful input (e.g. an approximately mass-normalised basis).
+    pub warnings: Vec<String>,
+    /// For a `type = "tube"` structure: its finite-element model and modes.
+    pub tube: Option<Box<TubeModel>>,
+}
+
+impl Case {
+    /// Reads and validates a case file. Relative paths in it are relative to its folder.
+    pub fn from_file(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let mut case = Self::from_toml_str(&text, base)?;
+        if case.title.is_empty() {
+            case.title = path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+        }
+        Ok(case)
+    }
+
+    /// Parses a case from TOML text; `base` resolves relative file names.
+    pub fn from_toml_str(text: &str, base: &Path) -> Result<Self> {
+        let (echo_value, file) = read_case_file(text)?;
+        let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
+        let title = file.title.clone().unwrap_or_default();
+        let mut warnings = Vec::new();
+        let (model, settings, tube) = file.build(base, &mut warnings)?;
+        Ok(Self {
+            title,
+            model,
+            settings,
+            echo,
+            tube,
+            warnings,
+        })
+    }
+
+    /// Builds a case from a model and settings made in code.
+    pub fn from_parts(title: &str, model: Model, settings: RunSettings) -> Self {
+        Self {
+            title: title.to_string(),
+            model,
+            settings,
+            echo: serde_json::Value::Null,
+            warnings: Vec::new(),
+            tube: None,
+        }
+    }
+}
+
+/// Checks that `text` reads as a case file (TOML syntax, known keys, types), without building
+/// the case; errors give their line and column.
+pub(crate) fn check_case_text(text: &str) -> Result<()> {
+    read_case_file(text).map(|_| ())
+}
+
+/// The case file as TOML and as its schema.
+fn read_case_file(text: &str) -> Result<(toml::Value, CaseFile)> {
+    let value: toml::Value = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
+    if value.get("base").is_some() && value.get("structure").is_none() {
+        return Err(Error::invalid(
+            "base",
+            "this is a study file (a base case and parameters to vary), not a case file: run it with `fretdyn sweep <file>`",
+        ));
+    }
+    let file: CaseFile = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
+    Ok((value, file))
+}
+
+/// A TOML error with the line and column (from 1) where it is in `text`.
+pub(crate) fn parse_error(text: &str, e: &toml::de::Error) -> Error {
+    let (line, column) = match e.span() {
+        Some(span) => {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            (line, column)
+        }
+        None => (0, 0),
+    };
+    Error::Parse {
+        line,
+        column,
+        message: e.message().trim().replace('\n', " "),
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CaseFile {
+    title: Option<String>,
+    time: TimeSection,
+    structure: StructureSection,
+    initial: Option<InitialSection>,
+    #[serde(default)]
+    contacts: Vec<ContactSection>,
+    #[serde(default)]
+    loads: Vec<LoadSection>,
+    #[serde(default)]
+    line_loads: Vec<LineLoadSection>,
+    #[serde(default)]
+    modal_loads: Vec<ModalLoadSection>,
+    #[serde(default)]
+    turbulence: Vec<TurbulenceSection>,
+    base_excitation: Option<BaseSection>,
+    #[serde(default)]
+    tangential: TangentialSection,
+    #[serde(default)]
+    output: OutputSection,
+    #[serde(default)]
+    statistics: StatisticsSection,
+}
+
+fn v3(a: [f64; 3]) -> Vector3<f64> {
+    Vector3::new(a[0], a[1], a[2])
+}
+
+impl CaseFile {
+    /// The model and settings, section by section in the order of the file's schema; the
+    /// first invalid value is the error.
+    fn build(
+        self,
+        base: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<(Model, RunSettings, Option<Box<TubeModel>>)> {
+        let (basis, tube) = self.structure.build(base, warnings)?;
+        basis.validate("structure")?;
+        let mut model = Model::new(basis);
+        self.build_contacts(tube.as_deref(), &mut model)?;
+        self.build_loads(base, tube.as_deref(), &mut model)?;
+        self.build_initial(&mut model)?;
+        model.validate()?;
+        let settings = self.settings(&model)?;
+        Ok((model, settings, tube))
+    }
+}
+
+/// The index of the structure point `name`; `field` is where the case names it.
+fn point_index(name: &str, field: String, model: &Model) -> Result<usize> {
+    model.basis.point_index(name).ok_or_else(|| {
+        let known: Vec<&str> = model.basis.points.iter().map(|p| p.name.as_str()).collect();
+        Error::invalid(
+            field,
+            format!("unknown point '{name}': the structure has {known:?}"),
+        )
+    })
+}

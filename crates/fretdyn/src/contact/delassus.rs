@@ -1,0 +1,471 @@
+//! The tangential problem of the Lagrange methods: the Delassus operator `H = L A⁻¹ Lᵀ` over the
+//! closed contacts, the right-hand side `b`, and the friction disks (THEORY §2, §4.2).
+//!
+//! `L` stacks, for each closed contact `k`, the two rows `t_aᵀ Φ_c` (a = 1, 2). With the stick
+//! constraint acting on the velocity `L q̇* + θ Δt L q̈` (θ = 1: half-step velocity, the default;
+//! θ = ½: the paper's literal full-step velocity),
+//!
+//! ```text
+//!     γ_imp = (v_imp − L q̇*)/(θ Δt),     b = L q̈_free − γ_imp,     H λ = b  (stick)
+//! ```
+//!
+//! and whatever λ is, the tangential velocity the constraint sees is `v_imp + θ Δt (b − H λ)`.
+//! All buffers are sized once for every contact being closed: assembling allocates nothing.
+//! The rows of a contact whose tangent basis never changes (a fixed plane) are computed once,
+//! and so are the blocks of `H` between two such contacts: a step then only gathers them.
+
+use nalgebra::{Matrix2, Vector2, Vector3};
+
+use crate::contact::friction::Slide;
+
+/// One closed contact in the tangential problem.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Slot {
+    /// Index of the contact in the model.
+    pub contact: usize,
+    /// Stick threshold `μ_s R_N`.
+    pub s_static: f64,
+    /// Slip force `μ_d R_N`.
+    pub s_dynamic: f64,
+}
+
+/// Workspace of the tangential problem for the contacts closed at this step.
+#[derive(Debug, Clone)]
+pub struct TangentialProblem {
+    p: usize,
+    slots: Vec<Slot>,
+    /// `L` rows, stored per contact (rows `2c`, `2c + 1` of contact `c`), p values each.
+    l: Vec<f64>,
+    /// `A⁻¹ Lᵀ` stored as rows: `al[r] = A⁻¹ ∘ l[r]`, same layout.
+    al: Vec<f64>,
+    /// Contacts whose rows are computed once ([`fix_rows`](Self::fix_rows)).
+    fixed: Vec<bool>,
+    /// `H` between fixed contacts, indexed by contact rows, row stride `2 * capacity`.
+    h_fixed: Vec<f64>,
+    /// `H` of the closed contacts, indexed by slot rows, row stride `2 * capacity`.
+    h: Vec<f64>,
+    /// Right-hand side `b`, by slot rows.
+    b: Vec<f64>,
+    stride: usize,
+}
+
+impl TangentialProblem {
+    /// Workspace for up to `contacts` closed contacts on `p` modes; contact indices of the
+    /// slots must be below `contacts`.
+    pub fn new(p: usize, contacts: usize) -> Self {
+        let rows = 2 * contacts;
+        Self {
+            p,
+            slots: Vec::with_capacity(contacts),
+            l: vec![0.0; rows * p],
+            al: vec![0.0; rows * p],
+            fixed: vec![false; contacts],
+            h_fixed: vec![0.0; rows * rows],
+            h: vec![0.0; rows * rows],
+            b: vec![0.0; rows],
+            stride: rows,
+        }
+    }
+
+    /// Declares that `contact` always has the tangent basis `tangents`: its rows, and its
+    /// blocks of `H` with the other fixed contacts, are computed now, once. `apply_a_inv`
+    /// computes `A⁻¹ l` (see [`push_with`](Self::push_with)).
+    pub fn fix_rows(
+        &mut self,
+        contact: usize,
+        tangents: &[Vector3<f64>; 2],
+        rows: &[f64],
+        apply_a_inv: impl Fn(&[f64], &mut [f64]),
+    ) {
+        self.fixed[contact] = false;
+        self.compute_rows(contact, tangents, rows, apply_a_inv);
+        self.fixed[contact] = true;
+        let p = self.p;
+        for other in 0..self.fixed.len() {
+            if !self.fixed[other] {
+                continue;
+            }
+            for a in 0..2 {
+                for b in 0..2 {
+                    let (r, c) = (2 * contact + a, 2 * other + b);
+                    let v = crate::structure::modal::dot(
+                        &self.l[r * p..(r + 1) * p],
+                        &self.al[c * p..(c + 1) * p],
+                    );
+                    self.h_fixed[r * self.stride + c] = v;
+                    self.h_fixed[c * self.stride + r] = v;
+                }
+            }
+        }
+    }
+
+    fn compute_rows(
+        &mut self,
+        contact: usize,
+        tangents: &[Vector3<f64>; 2],
+        rows: &[f64],
+        apply_a_inv: impl Fn(&[f64], &mut [f64]),
+    ) {
+        let p = self.p;
+        for (a, t) in tangents.iter().enumerate() {
+            let r = 2 * contact + a;
+            let l = &mut self.l[r * p..(r + 1) * p];
+            for i in 0..p {
+                l[i] = t.x * rows[i] + t.y * rows[p + i] + t.z * rows[2 * p + i];
+            }
+            apply_a_inv(l, &mut self.al[r * p..(r + 1) * p]);
+        }
+    }
+
+    /// Row of `L` (in the per-contact layout) of slot row `r`.
+    #[inline]
+    fn contact_row(&self, r: usize) -> usize {
+        2 * self.slots[r / 2].contact + r % 2
+    }
+
+    /// Removes every slot.
+    #[inline]
+    pub fn clear(&mut self) {
+        self.slots.clear();
+    }
+
+    /// Number of closed contacts `m` (the problem has `2m` unknowns).
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// True when no contact is closed.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.slots.is_empty()
+    }
+
+    /// The closed contacts.
+    #[inline]
+    pub fn slots(&self) -> &[Slot] {
+        &self.slots
+    }
+
+    /// Adds a closed contact with its tangent basis, point rows (3 × p), and the diagonal of
+    /// `A⁻¹` (modal coordinates); see [`push_with`](Self::push_with).
+    #[inline]
+    pub fn push(&mut self, slot: Slot, tangents: &[Vector3<f64>; 2], rows: &[f64], a_inv: &[f64]) {
+        self.push_with(slot, tangents, rows, |l, out| {
+            for i in 0..l.len() {
+                out[i] = a_inv[i] * l[i];
+            }
+        });
+    }
+
+    /// Adds a closed contact with its tangent basis and point rows (3 × p); `apply_a_inv(l, out)`
+    /// computes `out = A⁻¹ l` (ignored for a contact whose rows were fixed). The contact's
+    /// velocity terms enter `b` when [`assemble`](Self::assemble) is called.
+    #[inline]
+    pub fn push_with(
+        &mut self,
+        slot: Slot,
+        tangents: &[Vector3<f64>; 2],
+        rows: &[f64],
+        apply_a_inv: impl Fn(&[f64], &mut [f64]),
+    ) {
+        if !self.fixed[slot.contact] {
+            self.compute_rows(slot.contact, tangents, rows, apply_a_inv);
+        }
+        self.slots.push(slot);
+    }
+
+    /// Assembles `H` and `b = L q̈_free + (L q̇* − v_imp)/(θΔt)`. `v_imp(slot)` gives the
+    /// obstacle's tangential velocity at a slot's contact, in its tangent basis.
+    pub fn assemble(
+        &mut self,
+        qdd_free: &[f64],
+        qd_star: &[f64],
+        theta_dt: f64,
+        v_imp: impl Fn(&Slot) -> Vector2<f64>,
+    ) {
+        let p = self.p;
+        let n = 2 * self.slots.len();
+        for r in 0..n {
+            let lr_index = self.contact_row(r);
+            let lr = &self.l[lr_index * p..(lr_index + 1) * p];
+            let fixed_r = self.fixed[lr_index / 2];
+            for c in r..n {
+                let lc_index = self.contact_row(c);
+                let v = if fixed_r && self.fixed[lc_index / 2] {
+                    self.h_fixed[lr_index * self.stride + lc_index]
+                } else {
+                    crate::structure::modal::dot(lr, &self.al[lc_index * p..(lc_index + 1) * p])
+                };
+                self.h[r * self.stride + c] = v;
+                self.h[c * self.stride + r] = v;
+            }
+            let vimp = v_imp(&self.slots[r / 2])[r % 2];
+            self.b[r] = crate::structure::modal::dot(lr, qdd_free)
+                + (crate::structure::modal::dot(lr, qd_star) - vimp) / theta_dt;
+        }
+    }
+
+    /// Entry `H[r][c]` (scalar indices over the 2m unknowns).
+    #[inline]
+    pub fn h(&self, r: usize, c: usize) -> f64 {
+        self.h[r * self.stride + c]
+    }
+
+    /// The 2 × 2 block `H_kl`.
+    #[inline]
+    pub fn block(&self, k: usize, l: usize) -> Matrix2<f64> {
+        Matrix2::new(
+            self.h(2 * k, 2 * l),
+            self.h(2 * k, 2 * l + 1),
+            self.h(2 * k + 1, 2 * l),
+            self.h(2 * k + 1, 2 * l + 1),
+        )
+    }
+
+    /// `b_k`.
+    #[inline]
+    pub fn rhs(&self, k: usize) -> Vector2<f64> {
+        Vector2::new(self.b[2 * k], self.b[2 * k + 1])
+    }
+
+    /// `b_k − Σ_{l≠k} H_kl λ_l`: the right-hand side of contact k's local problem.
+    #[inline]
+    pub fn local_rhs(&self, k: usize, lambda: &[Vector2<f64>]) -> Vector2<f64> {
+        let mut c = self.rhs(k);
+        for (l, lam) in lambda.iter().enumerate().take(self.slots.len()) {
+            if l != k {
+                c -= self.block(k, l) * lam;
+            }
+        }
+        c
+    }
+
+    /// `(b − Hλ)_k`: contact k's tangential velocity relative to the obstacle, divided by θΔt.
+    #[inline]
+    pub fn residual_velocity(&self, k: usize, lambda: &[Vector2<f64>]) -> Vector2<f64> {
+        self.local_rhs(k, lambda) - self.block(k, k) * lambda[k]
+    }
+
+    /// Natural-map residual of the tangential problem (THEORY §4.2), the same measure for
+    /// every solver: per contact `r_i = λ_i − proj_{disk(s_i)}(λ_i + ρ_i w_i)` with
+    /// `w = b − Hλ` (the slip velocity over θΔt, along which a sliding λ points),
+    /// `ρ_i = 2/tr(H_ii)` and `s_i` the static threshold of a sticking contact, the dynamic one
+    /// of a sliding contact; it is 0 exactly when λ satisfies Coulomb's law. Returned as
+    /// `‖r‖ / max(‖λ‖, max_i s_i)`, relative to the friction forces at stake.
+    pub fn natural_map_residual(&self, lambda: &[Vector2<f64>], slide: &[Slide]) -> f64 {
+        let mut r2 = 0.0;
+        let mut l2 = 0.0;
+        let mut s_max = 0.0f64;
+        for (k, slot) in self.slots.iter().enumerate() {
+            let h = self.block(k, k);
+            let trace = h[(0, 0)] + h[(1, 1)];
+            let rho = if trace > 0.0 { 2.0 / trace } else { 0.0 };
+            let s = match slide[k] {
+                Slide::Stick => slot.s_static,
+                Slide::Slip => slot.s_dynamic,
+            };
+            let z = lambda[k] + self.residual_velocity(k, lambda) * rho;
+            let n = z.norm();
+            let projected = if n > s { z * (s / n) } else { z };
+            r2 += (lambda[k] - projected).norm_squared();
+            l2 += lambda[k].norm_squared();
+            s_max = s_max.max(slot.s_static);
+        }
+        let scale = l2.sqrt().max(s_max);
+        if scale > 0.0 { r2.sqrt() / scale } else { 0.0 }
+    }
+
+    /// `q̈ −= A⁻¹ Lᵀ λ`.
+    #[inline]
+    pub fn apply(&self, lambda: &[Vector2<f64>], qdd: &mut [f64]) {
+        let p = self.p;
+        for (k, lam) in lambda.iter().enumerate().take(self.slots.len()) {
+            for a in 0..2 {
+                let r = self.contact_row(2 * k + a);
+                let al = &self.al[r * p..(r + 1) * p];
+                let s = lam[a];
+                if s != 0.0 {
+                    for (q, v) in qdd.iter_mut().zip(al) {
+                        *q -= v * s;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Whether `H` is singular (redundant constraints, THEORY §4.6): a Cholesky pivot below
+    /// `1e-12` of the largest diagonal term. `work` must hold `(2m)² + 4m` values.
+    pub fn is_singular(&self, work: &mut [f64]) -> bool {
+        let n = 2 * self.slots.len();
+        if n == 0 {
+            return false;
+        }
+        let (a, rest) = work.split_at_mut(n * n);
+        let (x, rest) = rest.split_at_mut(n);
+        let diag = &mut rest[..n];
+        let mut dmax = 0.0f64;
+        for i in 0..n {
+            for j in 0..n {
+                a[i * n + j] = self.h(i, j);
+            }
+            diag[i] = a[i * n + i];
+            dmax = dmax.max(diag[i].abs());
+            x[i] = 0.0;
+        }
+        cholesky_solve(a, diag, x, n, 1e-12 * dmax.max(f64::MIN_POSITIVE))
+    }
+
+    /// Solves `H_SS λ_S = b_S − H_SF λ_F` for the stick slots `S` (those with `stick[k]`),
+    /// the others' λ fixed, by Cholesky on the `2|S|` unknowns. `work` must hold
+    /// `(2m)² + 4m` values and `index` 2m. Returns true when `H_SS` was singular (a pivot below `1e-12`
+    /// of the largest diagonal term), in which case a Tikhonov term of that size regularises
+    /// it (THEORY §4.6).
+    pub fn solve_stick(
+        &self,
+        stick: &[bool],
+        lambda: &mut [Vector2<f64>],
+        work: &mut [f64],
+        index: &mut [usize],
+    ) -> bool {
+        let m = self.slots.len();
+        let mut n = 0;
+        for k in 0..m {
+            if stick[k] {
+                index[n] = 2 * k;
+                index[n + 1] = 2 * k + 1;
+                n += 2;
+            }
+        }
+        if n == 0 {
+            return false;
+        }
+        let (a, rest) = work.split_at_mut(n * n);
+        let (x, rest) = rest.split_at_mut(n);
+        let diag = &mut rest[..n];
+        let mut dmax = 0.0f64;
+        for i in 0..n {
+            let ri = index[i];
+            for j in 0..n {
+                a[i * n + j] = self.h(ri, index[j]);
+            }
+            diag[i] = a[i * n + i];
+            dmax = dmax.max(diag[i].abs());
+            // rhs: b_i − Σ_{free slots} H λ
+            let mut v = self.b[ri];
+            for (l, lam) in lambda.iter().enumerate().take(m) {
+                if !stick[l] {
+                    v -= self.h(ri, 2 * l) * lam.x + self.h(ri, 2 * l + 1) * lam.y;
+                }
+            }
+            x[i] = v;
+        }
+        let singular = cholesky_solve(a, diag, x, n, 1e-12 * dmax.max(f64::MIN_POSITIVE));
+        for i in (0..n).step_by(2) {
+            lambda[index[i] / 2] = Vector2::new(x[i], x[i + 1]);
+        }
+        singular
+    }
+}
+
+/// In-place Cholesky solve of the SPD `n × n` system `a x = rhs` (rhs overwritten by x).
+/// Only the upper triangle of `a` is read; `diag` must hold its diagonal. A pivot below `tiny`
+/// marks the matrix singular: the factorisation is restarted on `a + shift·I` with the
+/// smallest `shift = tiny·10^k` that succeeds; when none does (a non-finite `a`), `x` is NaN.
+/// Returns whether regularisation was needed.
+fn cholesky_solve(a: &mut [f64], diag: &[f64], x: &mut [f64], n: usize, tiny: f64) -> bool {
+    // Factor into the lower triangle (diagonal included); the strict upper part keeps `a`.
+    let factor = |a: &mut [f64], shift: f64| -> bool {
+        for j in 0..n {
+            for i in j + 1..n {
+                a[i * n + j] = a[j * n + i];
+            }
+            a[j * n + j] = diag[j] + shift;
+        }
+        for j in 0..n {
+            let mut d = a[j * n + j];
+            for k in 0..j {
+                d -= a[j * n + k] * a[j * n + k];
+            }
+            if !(d > tiny) {
+                return false;
+            }
+            let d = d.sqrt();
+            a[j * n + j] = d;
+            for i in j + 1..n {
+                let mut s = a[i * n + j];
+                for k in 0..j {
+                    s -= a[i * n + k] * a[j * n + k];
+                }
+                a[i * n + j] = s / d;
+            }
+        }
+        true
+    };
+    let mut regularised = false;
+    if !factor(a, 0.0) {
+        regularised = true;
+        let mut shift = tiny.max(1e-300);
+        while !factor(a, shift) {
+            shift *= 10.0;
+            if !shift.is_finite() {
+                // a non-finite H (a diverging run): no shift helps. NaN multipliers make the
+                // step non-finite, and the run stops there as diverged (never a hang).
+                x[..n].fill(f64::NAN);
+                return true;
+            }
+        }
+    }
+    for i in 0..n {
+        let mut s = x[i];
+        for k in 0..i {
+            s -= a[i * n + k] * x[k];
+        }
+        x[i] = s / a[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let mut s = x[i];
+        for k in i + 1..n {
+            s -= a[k * n + i] * x[k];
+        }
+        x[i] = s / a[i * n + i];
+    }
+    regularised
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cholesky_of_a_non_finite_matrix_returns_nan_instead_of_looping() {
+        // a NaN pivot fails every shifted factorisation: this looped forever
+        let mut a = vec![1.0, 0.0, 0.0, f64::NAN];
+        let mut x = vec![1.0, 1.0];
+        assert!(cholesky_solve(&mut a, &[1.0, f64::NAN], &mut x, 2, 1e-12));
+        assert!(x.iter().all(|v| v.is_nan()));
+    }
+
+    #[test]
+    fn cholesky_matches_dense_solve_and_flags_singular() {
+        let n = 4;
+        let m = nalgebra::DMatrix::<f64>::from_fn(n, n, |i, j| ((i * 7 + j * 3) % 5) as f64 + 0.3);
+        let spd = &m * m.transpose() + nalgebra::DMatrix::identity(n, n);
+        let rhs = nalgebra::DVector::from_fn(n, |i, _| i as f64 - 1.5);
+        let mut a: Vec<f64> = (0..n * n).map(|k| spd[(k / n, k % n)]).collect();
+        let diag: Vec<f64> = (0..n).map(|i| spd[(i, i)]).collect();
+        let mut x: Vec<f64> = rhs.iter().copied().collect();
+        assert!(!cholesky_solve(&mut a, &diag, &mut x, n, 1e-12));
+        let exact = spd.clone().cholesky().unwrap().solve(&rhs);
+        for i in 0..n {
+            assert!((x[i] - exact[i]).abs() < 1e-12 * exact.amax());
+        }
+        // rank-deficient: two equal rows/columns
+        let mut a = vec![1.0, 1.0, 1.0, 1.0];
+        let mut x = vec![1.0, 1.0];
+        assert!(cholesky_solve(&mut a, &[1.0, 1.0], &mut x, 2, 1e-12));
+        assert!(x.iter().all(|v| v.is_finite()));
+        // the regularised solution still solves the consistent system
+        assert!((x[0] + x[1] - 1.0).abs() < 1e-6);
+    }
+}

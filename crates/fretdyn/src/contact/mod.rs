@@ -1,0 +1,188 @@
+//! **Stage 4 — the contacts.** What enters: a point of the modal basis, an obstacle (possibly
+//! moving), the normal law and the friction coefficients. What leaves: per contact, the gap
+//! and frame ([`obstacle`]), the normal penalty force ([`NormalLaw`], THEORY §3) and the
+//! tangential force from a friction law ([`friction`]) or from the Lagrange problem on the
+//! Delassus operator ([`delassus`]) solved by the [`tangential`] methods (THEORY §4, §7, §8).
+//!
+//! - [`obstacle`]: planes, bi-planes, circles, polygons: gap, normal, tangent frame;
+//! - [`motion`]: the imposed motion of an obstacle (THEORY §8);
+//! - [`friction`]: Coulomb coefficients, the local stick/slip solve;
+//! - [`delassus`]: the tangential problem `W λ + b` on the closed contacts (THEORY §4.2);
+//! - [`tangential`]: penalty, Active Set and projected Gauss–Seidel (THEORY §4.1, §4.3, §4.4).
+//!
+//! A contact itself ([`Contact`]: structure point, obstacle, normal law, Coulomb
+//! coefficients) is defined here.
+
+pub mod delassus;
+pub mod friction;
+pub mod motion;
+pub mod obstacle;
+pub mod tangential;
+
+use crate::contact::friction::Coulomb;
+use crate::error::{Error, Result};
+use nalgebra::Vector3;
+
+use crate::contact::motion::Motion;
+use crate::contact::obstacle::{ContactFrame, Obstacle};
+use crate::structure::modal::Point;
+
+/// Normal penalty law `R_N = max(0, K_N δ + C_N δ̇)` for `δ > 0`, `R_N = 0` otherwise (THEORY §3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NormalLaw {
+    /// Contact stiffness `K_N`, N/m (for a tube: the ovalisation stiffness).
+    pub stiffness: f64,
+    /// Contact damping `C_N`, N·s/m (0: elastic impact).
+    pub damping: f64,
+}
+
+impl NormalLaw {
+    /// Validated constructor; `field` prefixes error messages.
+    pub fn new(stiffness: f64, damping: f64, field: &str) -> Result<Self> {
+        if !(stiffness.is_finite() && stiffness > 0.0) {
+            return Err(Error::invalid(
+                format!("{field}.stiffness"),
+                format!("must be a positive contact stiffness K_N in N/m (got {stiffness})"),
+            ));
+        }
+        if !(damping.is_finite() && damping >= 0.0) {
+            return Err(Error::invalid(
+                format!("{field}.damping"),
+                format!("must be a contact damping C_N ≥ 0 in N·s/m (got {damping})"),
+            ));
+        }
+        Ok(Self { stiffness, damping })
+    }
+
+    /// Normal force magnitude for penetration `δ` and penetration rate `δ̇`; 0 when open and
+    /// never tensile.
+    #[inline]
+    pub fn force(&self, penetration: f64, penetration_rate: f64) -> f64 {
+        if penetration > 0.0 {
+            (self.stiffness * penetration + self.damping * penetration_rate).max(0.0)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// One contact of the model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Contact {
+    /// Name, used in outputs.
+    pub name: String,
+    /// Index of the structure point in the modal basis.
+    pub point: usize,
+    /// The obstacle.
+    pub obstacle: Obstacle,
+    /// Prescribed rigid motion of the obstacle ([`Motion::Fixed`] by default).
+    pub motion: Motion,
+    /// Outer radius `R` of the tube when the point is on its axis and the contact is on its
+    /// surface (0: the contact is at the point). The obstacle's gap or clearance is then the
+    /// clearance of the surface, the contact point is `x − R n`, and its velocity
+    /// `u̇ + θ̇ × (−R n) = u̇ + R n × θ̇`: the tube's rotations (torsion for the
+    /// circumferential slip in a hole, bending for the axial slip) enter the tangential
+    /// velocity and the friction force exerts a moment `−R n × R_T` on the tube.
+    pub radius: f64,
+    /// Normal penalty law.
+    pub normal: NormalLaw,
+    /// Static and dynamic friction coefficients.
+    pub friction: Coulomb,
+}
+
+impl Contact {
+    /// A contact at the point itself with a fixed obstacle.
+    pub fn new(
+        name: impl Into<String>,
+        point: usize,
+        obstacle: Obstacle,
+        normal: NormalLaw,
+        friction: Coulomb,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            point,
+            obstacle,
+            motion: Motion::Fixed,
+            radius: 0.0,
+            normal,
+            friction,
+        }
+    }
+
+    /// Frame of the obstacle at time `t` for the point's physical position `x` (the tube axis
+    /// when `radius > 0`): the obstacle translated by `d(t)`, its surface moving at `ḋ(t)`.
+    #[inline]
+    pub fn frame(&self, x: &Vector3<f64>, t: f64) -> ContactFrame {
+        if self.motion.is_fixed() {
+            return self.obstacle.frame(x);
+        }
+        let (d, v) = self.motion.at(t);
+        let mut frame = self.obstacle.frame(&(x - d));
+        frame.velocity = v;
+        frame
+    }
+
+    /// Position of the point relative to the obstacle at time `t`
+    /// ([`Obstacle::local`] of `x − d(t)`).
+    #[inline]
+    pub fn local(&self, x: &Vector3<f64>, t: f64) -> nalgebra::Vector2<f64> {
+        if self.motion.is_fixed() {
+            self.obstacle.local(x)
+        } else {
+            self.obstacle.local(&(x - self.motion.at(t).0))
+        }
+    }
+
+    /// True when the contact is on the tube surface rather than at the point.
+    #[inline]
+    pub fn at_surface(&self) -> bool {
+        self.radius > 0.0
+    }
+
+    /// Rows (3 × p) of the contact point on the surface for the normal `n`:
+    /// `Φ_u + R [n]_× Θ`, from the point's translation rows `Φ_u` and rotation rows `Θ`.
+    #[inline]
+    pub fn surface_rows(&self, point: &Point, n: &Vector3<f64>, out: &mut [f64]) {
+        let p = out.len() / 3;
+        let (u, th, r) = (&point.rows, &point.rotations, self.radius);
+        for i in 0..p {
+            let (tx, ty, tz) = (th[i], th[p + i], th[2 * p + i]);
+            out[i] = u[i] + r * (n.y * tz - n.z * ty);
+            out[p + i] = u[p + i] + r * (n.z * tx - n.x * tz);
+            out[2 * p + i] = u[2 * p + i] + r * (n.x * ty - n.y * tx);
+        }
+    }
+
+    /// The tangent basis when the contact's Delassus rows never change: a fixed tangent basis,
+    /// and (on the surface) a fixed normal.
+    pub fn fixed_tangents(&self) -> Option<[Vector3<f64>; 2]> {
+        match (&self.obstacle, self.at_surface()) {
+            (_, false) | (Obstacle::Plane(_), true) => self.obstacle.fixed_tangents(),
+            _ => None,
+        }
+    }
+
+    /// Checks the radius and the motion; `point` is the contact's point.
+    pub fn validate(&self, point: &Point, field: &str) -> Result<()> {
+        if !(self.radius.is_finite() && self.radius >= 0.0) {
+            return Err(Error::invalid(
+                format!("{field}.radius"),
+                format!(
+                    "must be the tube's outer radius ≥ 0 in m (got {})",
+                    self.radius
+                ),
+            ));
+        }
+        if self.at_surface() && point.rotations.is_empty() {
+            return Err(Error::invalid(
+                format!("{field}.radius"),
+                format!(
+                    "a contact on the tube surface needs the rotations of point '{}': use a tube structure, or give rotations (rows or 'rotations_<name>' in the .npz), or remove radius",
+                    point.name
+                ),
+            ));
+        }
+        self.motion.validate(&format!("{field}.motion"))
+    }
+}

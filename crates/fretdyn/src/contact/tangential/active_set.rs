@@ -1,0 +1,235 @@
+//! Active Set method on the tangential problem (THEORY §4.3, paper Algorithm 2).
+//!
+//! Iterates on statuses, not on λ:
+//! 1. initial statuses from the previous step (stick stays stick; slip keeps its direction;
+//!    a newly closed contact is guessed sliding along `b_i`, §4.5);
+//! 2. slip contacts: `λ_i = μ_d R_N,i d_i`;
+//! 3. stick contacts: `H_SS λ_S = b_S − H_SF λ_F` by Cholesky (regularised when singular, §4.6);
+//! 4. each contact's status is then tested on its own local problem, the others frozen
+//!    (right-hand side `c_i = b_i − Σ_{j≠i} H_ij λ_j`, exact local solve of §4.4):
+//!    stick with `|λ_i| > μ_s R_N,i` → slip; slip whose local problem is a stick (for an
+//!    isotropic `H_ii` this is exactly the paper's test "the slip velocity `(b − Hλ)_i` has
+//!    reversed against `d_i`") → stick; a slip direction is the direction of the exact local
+//!    slip solution, which makes `λ_i ∥ w_i` even when `H_ii` is not a multiple of the identity
+//!    (the plain update `d ← w/|w|`, or a reversal test made with a wrong direction guess, does
+//!    not converge then);
+//! 5. stop when no status and no slip direction changes.
+//!
+//! A status pattern that comes back is a cycle; it and the iteration bound are counted and the
+//! step is finished by the stated fallback: a projected Gauss–Seidel from the last λ.
+
+use nalgebra::Vector2;
+
+use super::{ActiveSetSettings, SolverStatistics, gauss_seidel};
+use crate::contact::delassus::TangentialProblem;
+use crate::contact::friction::{LocalSolve, Slide, local_solve};
+
+/// Memory of a contact between steps: its last status and slip direction.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct History {
+    /// Whether the contact was closed at the previous step.
+    pub closed: bool,
+    /// Its status then.
+    pub slide: Slide,
+    /// Its slip direction then (unit, in its tangent basis).
+    pub direction: Vector2<f64>,
+}
+
+impl Default for History {
+    fn default() -> Self {
+        Self {
+            closed: false,
+            slide: Slide::Stick,
+            direction: Vector2::zeros(),
+        }
+    }
+}
+
+/// How one Active Set solve ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Statuses settled after this many iterations.
+    Converged(usize),
+    /// A status pattern repeated: solved by the fallback.
+    Cycled(usize),
+    /// The iteration bound was reached: solved by the fallback.
+    IterationLimit(usize),
+}
+
+/// Active Set solver with its preallocated work space.
+#[derive(Debug, Clone)]
+pub struct ActiveSet {
+    settings: ActiveSetSettings,
+    stick: Vec<bool>,
+    direction: Vec<Vector2<f64>>,
+    patterns: Vec<u64>,
+    work: Vec<f64>,
+    index: Vec<usize>,
+}
+
+impl ActiveSet {
+    /// Work space for up to `contacts` closed contacts.
+    pub fn new(settings: ActiveSetSettings, contacts: usize) -> Self {
+        let n = 2 * contacts;
+        Self {
+            settings,
+            stick: vec![false; contacts],
+            direction: vec![Vector2::zeros(); contacts],
+            patterns: Vec::with_capacity(settings.max_iterations + 1),
+            work: vec![0.0; n * n + 2 * n],
+            index: vec![0; n],
+        }
+    }
+
+    /// Solves the problem; `history[contact]` gives each closed contact's previous status.
+    /// Writes λ and the statuses of the slots, and counts into `stats`.
+    pub fn solve(
+        &mut self,
+        problem: &TangentialProblem,
+        history: &[History],
+        lambda: &mut [Vector2<f64>],
+        slide: &mut [Slide],
+        stats: &mut SolverStatistics,
+    ) -> Outcome {
+        let m = problem.len();
+        let lambda = &mut lambda[..m];
+        // 1. initial statuses
+        for (k, slot) in problem.slots().iter().enumerate() {
+            let h = history[slot.contact];
+            if h.closed && h.slide == Slide::Stick {
+                self.stick[k] = true;
+            } else if h.closed && h.direction.norm() > 0.0 {
+                self.stick[k] = false;
+                self.direction[k] = h.direction;
+            } else {
+                let b = problem.rhs(k);
+                let nb = b.norm();
+                self.stick[k] = nb == 0.0;
+                self.direction[k] = if nb > 0.0 { b / nb } else { Vector2::zeros() };
+            }
+        }
+        self.patterns.clear();
+        self.patterns
+            .push(pattern(&self.stick[..m], &self.direction[..m]));
+
+        let mut iterations = 0;
+        let outcome = loop {
+            iterations += 1;
+            // 2. slip contacts on the dynamic circle
+            for (k, slot) in problem.slots().iter().enumerate() {
+                if !self.stick[k] {
+                    lambda[k] = self.direction[k] * slot.s_dynamic;
+                }
+            }
+            // 3. stick contacts by a direct solve
+            if problem.solve_stick(&self.stick[..m], lambda, &mut self.work, &mut self.index) {
+                stats.singular_delassus += 1;
+            }
+            // 4. status and direction updates
+            let mut status_changed = false;
+            let mut direction_changed = false;
+            for (k, slot) in problem.slots().iter().enumerate() {
+                // contact k's exact local problem, the others frozen
+                let local = |lambda: &[Vector2<f64>]| {
+                    local_solve(
+                        &problem.block(k, k),
+                        &problem.local_rhs(k, lambda),
+                        slot.s_static,
+                        slot.s_dynamic,
+                        LocalSolve::Exact,
+                    )
+                };
+                if self.stick[k] {
+                    if lambda[k].norm() > slot.s_static * (1.0 + 1e-12) {
+                        self.stick[k] = false;
+                        let (local, _) = local(lambda);
+                        let n = local.norm();
+                        self.direction[k] = if n > 0.0 {
+                            local / n
+                        } else {
+                            lambda[k] / lambda[k].norm()
+                        };
+                        status_changed = true;
+                    }
+                } else {
+                    let w = problem.residual_velocity(k, lambda);
+                    let (local, local_slide) = local(lambda);
+                    if local_slide == Slide::Stick {
+                        self.stick[k] = true;
+                        status_changed = true;
+                    } else {
+                        let n = local.norm();
+                        let d = if n > 0.0 { local / n } else { w / w.norm() };
+                        if (d - self.direction[k]).norm() > 1e-12 {
+                            self.direction[k] = d;
+                            direction_changed = true;
+                        }
+                    }
+                }
+            }
+            if !status_changed && !direction_changed {
+                break Outcome::Converged(iterations);
+            }
+            if status_changed {
+                let pat = pattern(&self.stick[..m], &self.direction[..m]);
+                if self.patterns.contains(&pat) {
+                    break Outcome::Cycled(iterations);
+                }
+                self.patterns.push(pat);
+            }
+            if iterations >= self.settings.max_iterations {
+                break Outcome::IterationLimit(iterations);
+            }
+        };
+
+        stats.as_iterations_total += iterations as u64;
+        stats.as_iterations_max = stats.as_iterations_max.max(iterations as u64);
+        match outcome {
+            Outcome::Converged(_) => {
+                for k in 0..m {
+                    slide[k] = if self.stick[k] {
+                        Slide::Stick
+                    } else {
+                        Slide::Slip
+                    };
+                }
+            }
+            Outcome::Cycled(_) | Outcome::IterationLimit(_) => {
+                if matches!(outcome, Outcome::Cycled(_)) {
+                    stats.as_cycles += 1;
+                } else {
+                    stats.as_iteration_limit += 1;
+                }
+                stats.as_fallbacks += 1;
+                let sweeps = gauss_seidel::solve(&self.settings.fallback, problem, lambda, slide);
+                stats.gs_sweeps_total += sweeps.count as u64;
+                stats.gs_sweeps_max = stats.gs_sweeps_max.max(sweeps.count as u64);
+                if !sweeps.converged {
+                    stats.gs_nonconverged_steps += 1;
+                }
+            }
+        }
+        outcome
+    }
+}
+
+/// FNV-1a hash of the statuses and of the slip directions (rounded to 1e-9): a cycle is a
+/// state that comes back, not just a stick/slip pattern (a slip that reverses goes
+/// slip → stick → slip with the opposite direction, which is progress). A hash collision could
+/// only make a new state look like a repeated one, which sends the step to the fallback:
+/// safe, and counted.
+fn pattern(stick: &[bool], direction: &[Vector2<f64>]) -> u64 {
+    let mut h: u64 = 0xcbf29ce484222325;
+    let mut mix = |v: u64| {
+        h ^= v;
+        h = h.wrapping_mul(0x100000001b3);
+    };
+    for (&s, d) in stick.iter().zip(direction) {
+        mix(s as u64 + 1);
+        if !s {
+            mix((d.x * 1e9).round() as i64 as u64);
+            mix((d.y * 1e9).round() as i64 as u64);
+        }
+    }
+    h
+}

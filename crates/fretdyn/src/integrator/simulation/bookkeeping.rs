@@ -1,0 +1,150 @@
+//! Phase 4 of a step — the bookkeeping: energy and powers for the balance, the output
+//! sample, the per-contact values for the statistics, and the results (THEORY §5).
+
+use super::{ContactState, RunResults, Simulation, Termination};
+use crate::contact::friction::Slide;
+use crate::results::recorder::{ContactSample, Recorder};
+use crate::results::statistics::StepValues;
+use crate::structure::modal::dot;
+
+impl Simulation<'_> {
+    /// Energy `E` and the powers `[external (loads and moving obstacles), modal damping,
+    /// contact damping, tangential]`.
+    pub(super) fn energy_and_powers(&self) -> (f64, [f64; 4]) {
+        let mut e = self.cd.energy();
+        let mut contact_damping = 0.0;
+        let mut tangential = 0.0;
+        let mut obstacle = 0.0;
+        for (c, s) in self.model.contacts.iter().zip(&self.contacts) {
+            if s.closed {
+                let d = s.frame.penetration;
+                e += 0.5 * c.normal.stiffness * d * d;
+                let rate = -s.frame.normal.dot(&s.v);
+                contact_damping += (s.normal_force - c.normal.stiffness * d) * rate;
+                tangential -= s.tangential_force.dot(&s.tangential_velocity());
+                // a moving obstacle works on the structure at the rate R·v_obstacle
+                obstacle += s.force().dot(&s.frame.velocity);
+            }
+        }
+        let external = dot(&self.external, &self.cd.qd) + obstacle;
+        (
+            e,
+            [
+                external,
+                self.cd.damping_power(),
+                contact_damping,
+                tangential,
+            ],
+        )
+    }
+
+    /// Records the output sample of the current step; returns the first contact whose slip
+    /// velocity or position is not finite (the modal state and the forces are checked by
+    /// [`Self::step`] already).
+    pub(super) fn sample(&mut self) -> Option<usize> {
+        let t = self.step as f64 * self.settings.dt;
+        if !self.recorder.push_state(t, &self.cd.q, &self.cd.qd) {
+            return None;
+        }
+        let mut non_finite = None;
+        for (k, (s, c)) in self.contacts.iter().zip(&self.model.contacts).enumerate() {
+            let vt = s.tangential_velocity();
+            let local = c.local(&s.x, t);
+            // a sum is non-finite when a term is (or when it overflows: no value to keep)
+            if !(vt.x + vt.y + local.x + local.y).is_finite() && non_finite.is_none() {
+                non_finite = Some(k);
+            }
+            self.recorder.contact(
+                k,
+                &ContactSample {
+                    normal_force: s.normal_force,
+                    tangential_force: [s.tangential_force.x, s.tangential_force.y],
+                    slip_velocity: [vt.x, vt.y],
+                    penetration: s.frame.penetration,
+                    status: s.status_code(),
+                    position: [local.x, local.y],
+                },
+            );
+        }
+        non_finite
+    }
+
+    /// The statistics so far, without ending the run (its recorder is empty).
+    pub fn partial_results(&self, wall_time: f64) -> RunResults {
+        let mut statistics = self.statistics.clone();
+        let contacts = statistics.finish(&self.settings.statistics, &self.names, self.settings.dt);
+        RunResults {
+            recorder: Recorder::new(0, self.cd.q.len(), self.contacts.len()),
+            contacts,
+            impacts: Vec::new(),
+            blocks: Vec::new(),
+            solver: self.solver_stats.clone(),
+            energy: self.energy.clone(),
+            steps: self.step,
+            dt: self.settings.dt,
+            stable_dt: self.stable_dt,
+            wall_time,
+            termination: Termination::InProgress { step: self.step },
+        }
+    }
+
+    /// Ends the run: window statistics, last partial block, the samples and impacts not
+    /// drained. `wall_time` is the caller's measure of the time spent stepping.
+    pub fn finish(mut self, wall_time: f64, termination: Termination) -> RunResults {
+        self.recorder.truncate();
+        let dt = self.settings.dt;
+        let steps = self.step;
+        let stable_dt = self.stable_dt;
+        let contacts = self
+            .statistics
+            .finish(&self.settings.statistics, &self.names, dt);
+        RunResults {
+            contacts,
+            impacts: std::mem::take(&mut self.statistics.impacts),
+            blocks: std::mem::take(&mut self.statistics.blocks),
+            recorder: self.recorder,
+            solver: self.solver_stats,
+            energy: self.energy,
+            steps,
+            dt,
+            stable_dt,
+            wall_time,
+            termination,
+        }
+    }
+}
+
+/// One contact's values of the step ending at `t`, for the statistics (THEORY §5).
+#[inline]
+pub(super) fn step_values(s: &ContactState, c: &crate::contact::Contact, t: f64) -> StepValues {
+    let local = c.local(&s.x, t);
+    let (radial, direction) = if c.obstacle.is_hole() {
+        let r = local.norm();
+        let unit = if r > 0.0 {
+            [local.x / r, local.y / r]
+        } else {
+            [1.0, 0.0]
+        };
+        (r, unit)
+    } else {
+        (local.x, [1.0, 0.0])
+    };
+    let (slip_speed, friction_power) = if s.closed {
+        let vt = s.tangential_velocity();
+        (vt.norm(), s.tangential_force.dot(&vt).abs())
+    } else {
+        (0.0, 0.0)
+    };
+    StepValues {
+        t,
+        closed: s.closed,
+        stick: s.slide == Slide::Stick,
+        normal: s.normal_force,
+        tangential: s.tangential_force.norm(),
+        slip_speed,
+        friction_power,
+        penetration: s.frame.penetration,
+        radial,
+        direction,
+    }
+}

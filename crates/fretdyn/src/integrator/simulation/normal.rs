@@ -1,0 +1,38 @@
+//! Phase 2 of a step — the modal force: external force plus the contact forces of the closed
+//! contacts, with the penalty tangential law (THEORY §2 step 4, §4.1).
+
+use super::{Simulation, Tangential, contact_rows, contact_states};
+use crate::structure::modal::project_add;
+
+impl Simulation<'_> {
+    /// Step 4 (and the penalty tangential forces): modal force `f = f_ext + Σ Φ_cᵀ R_c`.
+    pub(super) fn contact_forces(&mut self) {
+        self.force.copy_from_slice(&self.external);
+        for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
+            if let Tangential::Penalty { settings, contacts } = &mut self.tangential {
+                if state.closed {
+                    let vt = state.tangential_velocity();
+                    state.tangential_force = contacts[k].force(
+                        settings,
+                        &c.friction,
+                        &state.frame.tangents,
+                        &state.x_relative,
+                        vt,
+                        state.normal_force,
+                    );
+                    state.slide = contacts[k].slide;
+                } else {
+                    contacts[k].open();
+                }
+            }
+            if state.closed {
+                let f = state.force();
+                project_add(
+                    contact_rows(self.model, &self.surface_rows, k),
+                    &f,
+                    &mut self.force,
+                );
+            }
+        }
+    }
+}

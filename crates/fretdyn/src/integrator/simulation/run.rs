@@ -1,0 +1,142 @@
+//! A run as a whole: progress, termination, results, the in-memory driver ([`simulate`],
+//! [`run`]), divergence and the snapshot a checkpoint holds.
+
+use std::ops::ControlFlow;
+
+use serde::Serialize;
+
+use super::{RunSettings, Simulation};
+use crate::contact::tangential::SolverStatistics;
+use crate::error::Result;
+use crate::model::Model;
+use crate::results::energy::EnergyBalance;
+use crate::results::recorder::Recorder;
+use crate::results::statistics::{BlockStatistics, ContactStatistics, Impact};
+use std::time::Instant;
+
+/// Progress report passed to the observer of [`run`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Progress {
+    /// Steps done.
+    pub step: u64,
+    /// Steps in the run.
+    pub total: u64,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum Termination {
+    /// Every step was done.
+    Completed,
+    /// The state became non-finite at `step`; results up to the previous sample are kept.
+    Diverged {
+        step: u64,
+        time: f64,
+        /// The contact whose force was non-finite first, if any.
+        contact: Option<String>,
+    },
+    /// The observer asked to stop.
+    Stopped { step: u64 },
+    /// Still running (statistics of a checkpoint).
+    InProgress { step: u64 },
+}
+
+/// Everything a run produces.
+#[derive(Debug, Clone)]
+pub struct RunResults {
+    /// Output time histories.
+    pub recorder: Recorder,
+    /// Per-contact statistics over every step of the window (THEORY §5).
+    pub contacts: Vec<ContactStatistics>,
+    /// Finished impacts of the window, in the order they ended (not drained by a streaming
+    /// driver).
+    pub impacts: Vec<Impact>,
+    /// Per-block statistics, block by block, contact by contact (when blocks are set).
+    pub blocks: Vec<BlockStatistics>,
+    /// Tangential solver counters.
+    pub solver: SolverStatistics,
+    /// Energy balance.
+    pub energy: EnergyBalance,
+    /// Steps done.
+    pub steps: u64,
+    /// Time step, s.
+    pub dt: f64,
+    /// Stability limit of the time step, s.
+    pub stable_dt: f64,
+    /// Wall-clock time of the step loop, s.
+    pub wall_time: f64,
+    /// How the run ended.
+    pub termination: Termination,
+}
+
+impl RunResults {
+    /// Steps per second of wall time.
+    pub fn steps_per_second(&self) -> f64 {
+        if self.wall_time > 0.0 {
+            self.steps as f64 / self.wall_time
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Runs `model` with `settings` without progress reporting.
+pub fn simulate(model: &Model, settings: &RunSettings) -> Result<RunResults> {
+    run(model, settings, |_| ControlFlow::Continue(()))
+}
+
+/// Runs `model` with `settings`. `observer` is called every 1024 steps and at the end; it may
+/// stop the run by returning `ControlFlow::Break`.
+///
+/// Errors are input errors (including a Δt above the stable limit). A run that diverges or is
+/// stopped returns `Ok` with its [`Termination`] and the results written so far.
+pub fn run(
+    model: &Model,
+    settings: &RunSettings,
+    mut observer: impl FnMut(Progress) -> ControlFlow<()>,
+) -> Result<RunResults> {
+    let start = Instant::now();
+    let mut sim = Simulation::new(model, settings)?;
+    let total = settings.steps;
+    let mut termination = Termination::Completed;
+    while sim.steps_done() < total {
+        if let Err(d) = sim.step() {
+            termination = d.into_termination(model);
+            break;
+        }
+        let n = sim.steps_done();
+        if n % 1024 == 0 && n < total && observer(Progress { step: n, total }).is_break() {
+            termination = Termination::Stopped { step: n };
+            break;
+        }
+    }
+    let wall_time = start.elapsed().as_secs_f64();
+    let _ = observer(Progress {
+        step: sim.steps_done(),
+        total,
+    });
+    Ok(sim.finish(wall_time, termination))
+}
+
+/// A step whose state became non-finite.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Divergence {
+    /// The step, counted from 1.
+    pub step: u64,
+    /// Its end time, s.
+    pub time: f64,
+    /// The contact whose force was non-finite first, if any.
+    pub contact: Option<usize>,
+}
+
+impl Divergence {
+    /// The [`Termination`] it causes.
+    pub fn into_termination(self, model: &Model) -> Termination {
+        Termination::Diverged {
+            step: self.step,
+            time: self.time,
+            contact: self.contact.map(|c| model.contacts[c].name.clone()),
+        }
+    }
+}

@@ -1,0 +1,199 @@
+//! Phase 3 of a step — the Lagrange tangential solve: the Delassus problem on the closed
+//! contacts, solved by projected Gauss–Seidel or Active Set, applied to the acceleration
+//! (THEORY §2 step 6, §4.2–§4.6).
+
+use nalgebra::Vector2;
+
+use super::{RunSettings, Simulation, contact_rows};
+use crate::contact::delassus::{Slot, TangentialProblem};
+use crate::contact::friction::Slide;
+use crate::contact::tangential::active_set::{ActiveSet, History};
+use crate::contact::tangential::penalty::PenaltyContact;
+use crate::contact::tangential::{StickVelocity, gauss_seidel};
+use crate::integrator::central_difference::CentralDifference;
+use crate::model::Model;
+
+impl Simulation<'_> {
+    /// Step 6 for the Lagrange methods.
+    pub(super) fn lagrange(&mut self) {
+        let Tangential::Lagrange {
+            problem,
+            solver,
+            theta_dt,
+            lambda,
+            slide,
+            history,
+            previous_lambda,
+            work,
+        } = &mut self.tangential
+        else {
+            return;
+        };
+        problem.clear();
+        for (k, (c, state)) in self.model.contacts.iter().zip(&self.contacts).enumerate() {
+            if state.closed {
+                let cd = &self.cd;
+                problem.push_with(
+                    Slot {
+                        contact: k,
+                        s_static: c.friction.mu_static * state.normal_force,
+                        s_dynamic: c.friction.mu_dynamic * state.normal_force,
+                    },
+                    &state.frame.tangents,
+                    contact_rows(self.model, &self.surface_rows, k),
+                    |l, out| cd.apply_a_inv(l, out),
+                );
+            }
+        }
+        if problem.is_empty() {
+            history.iter_mut().for_each(|h| h.closed = false);
+            return;
+        }
+        let (contacts, model, dt) = (&self.contacts, self.model, self.settings.dt);
+        let half_step = self.settings.stick_velocity == StickVelocity::HalfStep;
+        let step = self.step;
+        problem.assemble(&self.cd.qdd, &self.cd.qd_star, *theta_dt, |slot| {
+            let f = &contacts[slot.contact].frame;
+            let motion = &model.contacts[slot.contact].motion;
+            // the half-step velocity moves the point from t_{n+1} to t_{n+2}: the obstacle's
+            // velocity over that step, so that a sticking point keeps its place on the
+            // obstacle exactly; the full-step one is the mean of two such steps
+            // (Motion::full_step_velocity, the velocity the slip is measured against)
+            let v = if motion.is_fixed() {
+                f.velocity
+            } else if half_step {
+                motion.step_velocity(step, dt)
+            } else {
+                motion.full_step_velocity(step, dt)
+            };
+            Vector2::new(f.tangents[0].dot(&v), f.tangents[1].dot(&v))
+        });
+        let m = problem.len();
+        for (k, slot) in problem.slots().iter().enumerate() {
+            let warm = match solver {
+                LagrangeSolver::GaussSeidel(s) => s.warm_start,
+                LagrangeSolver::ActiveSet(_) => false,
+            };
+            lambda[k] = if warm && history[slot.contact].closed {
+                previous_lambda[slot.contact]
+            } else {
+                Vector2::zeros()
+            };
+        }
+        self.solver_stats.lagrange_steps += 1;
+        let mut residual = None;
+        match solver {
+            LagrangeSolver::GaussSeidel(s) => {
+                // Gauss–Seidel tolerates a singular H (the modal forces are unique, λ is
+                // not); it is counted all the same (THEORY §4.6).
+                if problem.is_singular(work) {
+                    self.solver_stats.singular_delassus += 1;
+                }
+                let sweeps = gauss_seidel::solve(s, problem, &mut lambda[..m], &mut slide[..m]);
+                self.solver_stats.gs_sweeps_total += sweeps.count as u64;
+                self.solver_stats.gs_sweeps_max =
+                    self.solver_stats.gs_sweeps_max.max(sweeps.count as u64);
+                if !sweeps.converged {
+                    self.solver_stats.gs_nonconverged_steps += 1;
+                }
+                residual = sweeps.residual;
+            }
+            LagrangeSolver::ActiveSet(a) => {
+                a.solve(
+                    problem,
+                    history,
+                    &mut lambda[..m],
+                    &mut slide[..m],
+                    &mut self.solver_stats,
+                );
+            }
+        }
+        let residual =
+            residual.unwrap_or_else(|| problem.natural_map_residual(&lambda[..m], &slide[..m]));
+        self.solver_stats.add_residual(residual);
+        problem.apply(&lambda[..m], &mut self.cd.qdd);
+        for (k, slot) in problem.slots().iter().enumerate() {
+            // held: both half-step velocities of q̇_{n+1} imposed (only this step's with the
+            // full-step constraint)
+            let before = &history[slot.contact];
+            self.contacts[slot.contact].held = slide[k] == Slide::Stick
+                && (!half_step || (before.closed && before.slide == Slide::Stick));
+        }
+        history.iter_mut().for_each(|h| h.closed = false);
+        for (k, slot) in problem.slots().iter().enumerate() {
+            let state = &mut self.contacts[slot.contact];
+            state.tangential_force = -lambda[k];
+            state.slide = slide[k];
+            let n = lambda[k].norm();
+            history[slot.contact] = History {
+                closed: true,
+                slide: slide[k],
+                direction: if n > 0.0 {
+                    lambda[k] / n
+                } else {
+                    Vector2::zeros()
+                },
+            };
+            previous_lambda[slot.contact] = lambda[k];
+        }
+    }
+}
+
+/// Method-specific state (one per run, so the size difference of the variants is irrelevant).
+#[allow(clippy::large_enum_variant)]
+pub(super) enum Tangential {
+    Penalty {
+        settings: crate::contact::tangential::PenaltySettings,
+        contacts: Vec<PenaltyContact>,
+    },
+    Lagrange {
+        problem: TangentialProblem,
+        solver: LagrangeSolver,
+        theta_dt: f64,
+        lambda: Vec<Vector2<f64>>,
+        slide: Vec<Slide>,
+        /// Per contact: previous step's status, direction and λ (warm start).
+        history: Vec<History>,
+        previous_lambda: Vec<Vector2<f64>>,
+        /// Work space of the singularity check.
+        work: Vec<f64>,
+    },
+}
+
+pub(super) enum LagrangeSolver {
+    GaussSeidel(crate::contact::tangential::GaussSeidelSettings),
+    ActiveSet(Box<ActiveSet>),
+}
+
+impl Tangential {
+    pub(super) fn lagrange(
+        model: &Model,
+        cd: &CentralDifference,
+        settings: &RunSettings,
+        solver: LagrangeSolver,
+    ) -> Self {
+        let nc = model.contacts.len();
+        let mut problem = TangentialProblem::new(model.basis.modes(), nc);
+        for (k, c) in model.contacts.iter().enumerate() {
+            if let Some(t) = c.fixed_tangents() {
+                let point = &model.basis.points[c.point];
+                let mut rows = point.rows.clone();
+                if c.at_surface() {
+                    // a plane: the normal never changes
+                    c.surface_rows(point, &c.frame(&point.coords, 0.0).normal, &mut rows);
+                }
+                problem.fix_rows(k, &t, &rows, |l, out| cd.apply_a_inv(l, out));
+            }
+        }
+        Tangential::Lagrange {
+            problem,
+            solver,
+            theta_dt: settings.stick_velocity.theta() * settings.dt,
+            lambda: vec![Vector2::zeros(); nc],
+            slide: vec![Slide::Stick; nc],
+            history: vec![History::default(); nc],
+            previous_lambda: vec![Vector2::zeros(); nc],
+            work: vec![0.0; 4 * nc * nc + 8 * nc],
+        }
+    }
+}

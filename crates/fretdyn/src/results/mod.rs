@@ -1,0 +1,18 @@
+//! **Stage 7 — the results.** What enters: the state of each step (sampled histories, contact
+//! forces, energies). What leaves: `results.npz`, `summary.json`, streamed series and
+//! checkpoints (THEORY §5, §11).
+//!
+//! - [`recorder`]: the sampled time histories kept in memory;
+//! - [`statistics`]: per-contact wear work rate, impacts, slip, blocks (THEORY §5, §11);
+//! - [`energy`]: the discrete energy balance (THEORY §5);
+//! - [`output`]: `results.npz` and `summary.json`;
+//! - [`stream`]: long runs streamed to disk by chunks, checkpoints and resume.
+//!
+//! The step loop ([`crate::integrator`]) writes into [`recorder`], [`statistics`] and [`energy`];
+//! [`output`] and [`stream`] read the finished or running simulation.
+
+pub mod energy;
+pub mod output;
+pub mod recorder;
+pub mod statistics;
+pub mod stream;

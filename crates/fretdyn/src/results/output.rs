@@ -1,0 +1,93 @@
+//! Files: `results.npz` (time histories, opened by `numpy.load`) and `summary.json`
+//! (THEORY §5).
+//!
+//! Results are written to a temporary name and renamed (`files::write_atomically`), so a failed
+//! write never leaves a truncated file under the final name.
+
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use ndarray_npy::NpzWriter;
+use serde_json::json;
+
+use crate::error::Result;
+use crate::files::write_atomically;
+use crate::integrator::simulation::RunResults;
+
+/// Writes `results.npz` in `dir` with the arrays of [`crate::results::recorder::Recorder`]:
+/// `t`, `q`, `qdot`, `contact_normal_force`, `contact_tangential_force`,
+/// `contact_slip_velocity`, `contact_penetration`, `contact_status`, `contact_position`
+/// (contact names are in `summary.json`, in the same order). A streamed run
+/// ([`crate::results::stream`]) writes the same keys.
+pub fn write_results_npz(dir: &Path, results: &RunResults) -> Result<PathBuf> {
+    let r = &results.recorder;
+    let path = dir.join("results.npz");
+    write_atomically(&path, |file| {
+        let mut npz = NpzWriter::new(BufWriter::new(file));
+        let e = |err: ndarray_npy::WriteNpzError| std::io::Error::other(err.to_string());
+        npz.add_array("t", &r.t).map_err(e)?;
+        npz.add_array("q", &r.q).map_err(e)?;
+        npz.add_array("qdot", &r.qdot).map_err(e)?;
+        npz.add_array("contact_normal_force", &r.normal_force)
+            .map_err(e)?;
+        npz.add_array("contact_tangential_force", &r.tangential_force)
+            .map_err(e)?;
+        npz.add_array("contact_slip_velocity", &r.slip_velocity)
+            .map_err(e)?;
+        npz.add_array("contact_penetration", &r.penetration)
+            .map_err(e)?;
+        npz.add_array("contact_status", &r.status).map_err(e)?;
+        npz.add_array("contact_position", &r.position).map_err(e)?;
+        npz.finish().map_err(e)?;
+        Ok(())
+    })?;
+    Ok(path)
+}
+
+/// The JSON summary of a run: the case echoed, per-contact statistics, energy balance, solver
+/// statistics, steps, wall time and steps/s.
+pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
+    let s = &results.solver;
+    json!({
+        "fretdyn_version": env!("CARGO_PKG_VERSION"),
+        "title": case.title,
+        "warnings": case.warnings,
+        "termination": results.termination,
+        "time": {
+            "dt": results.dt,
+            "stable_dt": results.stable_dt,
+            "steps": results.steps,
+            "simulated_time": results.steps as f64 * results.dt,
+            "samples": results.steps / case.settings.output_every + 1,
+        },
+        "contacts": results.contacts,
+        "contact_geometry": case.model.contacts.iter().map(|c| json!({
+            "name": c.name,
+            "obstacle": c.obstacle.kind(),
+            "outline": c.obstacle.outline(),
+        })).collect::<Vec<_>>(),
+        "energy_balance": results.energy,
+        "solver": {
+            "counters": s,
+            "gauss_seidel_sweeps_mean": s.gs_sweeps_mean(),
+            "active_set_iterations_mean": s.as_iterations_mean(),
+            "natural_map_residual_mean": s.residual_mean(),
+        },
+        "performance": {
+            "wall_time_s": results.wall_time,
+            "steps_per_second": results.steps_per_second(),
+        },
+        "case": case.echo,
+    })
+}
+
+/// Writes `summary.json` in `dir`.
+pub fn write_summary(dir: &Path, summary: &serde_json::Value) -> Result<PathBuf> {
+    let path = dir.join("summary.json");
+    write_atomically(&path, |mut file| {
+        serde_json::to_writer_pretty(&mut file, summary).map_err(std::io::Error::other)?;
+        use std::io::Write;
+        file.write_all(b"\n")
+    })?;
+    Ok(path)
+}

@@ -1,0 +1,341 @@
+//! A tube as engineers describe it — section, material, fluids, path, supports, named points —
+//! turned into the modal basis the time integrator uses (and, for the tests, into the
+//! physical-coordinates model of the same finite elements).
+//!
+//! The beam finite elements are in [`crate::structure::beam`], the eigen solver in [`crate::structure::eigen`]. A
+//! named point sits at a node; with an `offset` (from the tube axis to a point of its outer
+//! surface, where it touches a support) its rows include the rotations:
+//! `u_surface = u + θ × r`.
+
+use nalgebra::{DMatrix, Vector3};
+
+use crate::error::{Error, Result};
+use crate::loads::spatial_correlation::LineCell;
+use crate::model::{Model, PhysicalMatrices};
+use crate::structure::beam::{Assembled, BeamModel, Dof, Mesh};
+use crate::structure::eigen::{ModeSelection, Modes, lowest_modes};
+use crate::structure::modal::{ModalBasis, Point};
+
+/// A named point of the tube: a node, and an offset from the axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedPoint {
+    /// Name used by contacts, loads and outputs.
+    pub name: String,
+    /// Node index in the mesh.
+    pub node: usize,
+    /// Offset from the node (on the axis) to the point, m.
+    pub offset: Vector3<f64>,
+}
+
+/// Modal damping of the basis.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Damping {
+    /// The same ratio ξ for every mode.
+    Constant(f64),
+    /// One ratio per mode (as many as modes kept).
+    PerMode(Vec<f64>),
+    /// Rayleigh `C = α M + β K`: `ξ_i = α/(2ω_i) + β ω_i/2`.
+    Rayleigh { alpha: f64, beta: f64 },
+}
+
+/// A tube finite-element model with its named points, mode selection and damping.
+#[derive(Debug, Clone)]
+pub struct TubeStructure {
+    /// Mesh, tube properties and restraints.
+    pub beam: BeamModel,
+    /// Named points.
+    pub points: Vec<NamedPoint>,
+    /// Which modes to keep.
+    pub selection: ModeSelection,
+    /// Modal damping.
+    pub damping: Damping,
+}
+
+/// The modal basis of a tube, with what was computed to get it.
+#[derive(Debug, Clone)]
+pub struct TubeBasis {
+    /// The basis restricted to the named points (what the time integrator uses).
+    pub basis: ModalBasis,
+    /// Reduced mass and stiffness matrices.
+    pub assembled: Assembled,
+    /// Every kept mode at every free DOF.
+    pub modes: Modes,
+}
+
+impl TubeStructure {
+    /// Assembles, computes the modes and extracts the rows of the named points.
+    pub fn modal_basis(&self) -> Result<TubeBasis> {
+        let assembled = self.beam.assemble()?;
+        let n = assembled.mass.nrows();
+        if let ModeSelection::Count(count) = self.selection {
+            if count > n {
+                return Err(Error::invalid(
+                    "structure.modes",
+                    format!(
+                        "{count} modes asked, but the tube has {n} free DOFs, hence {n} modes: set modes ≤ {n} (all of them), or refine mesh_size for more"
+                    ),
+                ));
+            }
+        }
+        let modes = lowest_modes(&assembled.mass, &assembled.stiffness, self.selection)
+            .map_err(|e| match e {
+                Error::Invalid { field, message } if field == "structure" => Error::invalid(
+                    field,
+                    format!(
+                        "{message} (the tube's outer_diameter and wall_thickness are in m, density in kg/m³, young_modulus in Pa)"
+                    ),
+                ),
+                other => other,
+            })?;
+        let p = modes.omega.len();
+        let damping_ratio = match &self.damping {
+            Damping::Constant(x) => vec![*x; p],
+            Damping::PerMode(v) => {
+                if v.len() < p {
+                    return Err(Error::invalid(
+                        "structure.damping_ratio",
+                        format!(
+                            "has {} values for {p} modes kept: give one per mode",
+                            v.len()
+                        ),
+                    ));
+                }
+                v[..p].to_vec()
+            }
+            Damping::Rayleigh { alpha, beta } => {
+                let ratios: Vec<f64> = modes
+                    .omega
+                    .iter()
+                    .map(|w| {
+                        if *w > 0.0 {
+                            0.5 * (alpha / w + beta * w)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                if let Some(i) = ratios.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
+                    return Err(Error::invalid(
+                        "structure.rayleigh",
+                        format!(
+                            "α = {alpha}, β = {beta} give mode {} (ω = {:e} rad/s) the damping ratio ξ = α/(2ω) + βω/2 = {}: give α ≥ 0 in 1/s and β ≥ 0 in s that make it a finite number",
+                            i + 1,
+                            modes.omega[i],
+                            ratios[i]
+                        ),
+                    ));
+                }
+                ratios
+            }
+        };
+        let points = self.named_points(&assembled, &modes.shapes);
+        Ok(TubeBasis {
+            basis: ModalBasis {
+                omega: modes.omega.clone(),
+                damping_ratio,
+                points,
+                // p × 3, column-major: the 3 × p row-major layout of `participation`
+                participation: (modes.shapes.transpose() * &assembled.base_inertia)
+                    .iter()
+                    .copied()
+                    .collect(),
+            },
+            assembled,
+            modes,
+        })
+    }
+
+    /// The same finite elements in physical coordinates with Rayleigh damping
+    /// `C = α M + β K` — the reference solver of the tests (small models only: dense).
+    pub fn physical_model(&self, alpha: f64, beta: f64) -> Result<Model> {
+        let assembled = self.beam.assemble()?;
+        let n = assembled.mass.nrows();
+        let points = self.named_points(&assembled, &DMatrix::<f64>::identity(n, n));
+        let damping = &assembled.mass * alpha + &assembled.stiffness * beta;
+        let participation: Vec<f64> = assembled.base_inertia.iter().copied().collect();
+        let mut model = Model::physical(
+            PhysicalMatrices {
+                mass: assembled.mass,
+                damping,
+                stiffness: assembled.stiffness,
+            },
+            points,
+        );
+        model.basis.participation = participation;
+        Ok(model)
+    }
+}
+
+impl TubeStructure {
+    /// The named points with their rows taken from `shapes` (n × p, over the reduced DOFs).
+    fn named_points(&self, assembled: &Assembled, shapes: &DMatrix<f64>) -> Vec<Point> {
+        self.points
+            .iter()
+            .map(|pt| Point {
+                name: pt.name.clone(),
+                coords: self.beam.mesh.nodes[pt.node] + pt.offset,
+                rows: point_rows(assembled, shapes, pt),
+                rotations: rotation_rows(assembled, shapes, pt.node),
+            })
+            .collect()
+    }
+}
+
+/// A node of a tube under a line load: its arc length, the length of tube it carries, and its
+/// translation rows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LineNode {
+    /// Arc length `s` along the tube from its first node, m.
+    pub s: f64,
+    /// Tributary length `w`, m: a uniform load `f` per unit length over the span gives the
+    /// nodal force `w f` (lumped, statically equivalent element by element).
+    pub weight: f64,
+    /// Translation rows (3 × p, row-major).
+    pub rows: Vec<f64>,
+}
+
+impl TubeStructure {
+    /// Length of the tube along its axis, m.
+    pub fn length(&self) -> f64 {
+        let n = &self.beam.mesh.nodes;
+        self.beam
+            .mesh
+            .elements
+            .iter()
+            .map(|[a, b]| (n[*b] - n[*a]).norm())
+            .sum()
+    }
+
+    /// The elements under a line load on the arc-length span `[s0, s1]`, clipped to it, and
+    /// the mesh node of each row they refer to (the nodes with a share of the load, in mesh
+    /// order). Arc lengths run along the elements from the tube's first node.
+    pub fn line_cells(&self, s0: f64, s1: f64) -> (Vec<usize>, Vec<LineCell>) {
+        let mesh = &self.beam.mesh;
+        let mut s = vec![0.0; mesh.nodes.len()];
+        let mut acc = 0.0;
+        let mut pieces = Vec::new();
+        for [a, b] in &mesh.elements {
+            let len = (mesh.nodes[*b] - mesh.nodes[*a]).norm();
+            s[*a] = acc;
+            acc += len;
+            s[*b] = acc;
+            let (lo, hi) = (s[*a].max(s0), s[*b].min(s1));
+            if hi > lo && len > 0.0 {
+                pieces.push(([*a, *b], [s[*a], s[*b]], [lo, hi]));
+            }
+        }
+        let mut row = vec![usize::MAX; mesh.nodes.len()];
+        for (nodes, _, _) in &pieces {
+            for &i in nodes {
+                row[i] = 0;
+            }
+        }
+        let mut rows = Vec::new();
+        for (i, r) in row.iter_mut().enumerate() {
+            if *r == 0 {
+                *r = rows.len();
+                rows.push(i);
+            }
+        }
+        let cells = pieces
+            .into_iter()
+            .map(|([a, b], ends, loaded)| LineCell {
+                nodes: [row[a], row[b]],
+                ends,
+                loaded,
+            })
+            .collect();
+        (rows, cells)
+    }
+
+    /// The nodes carrying a line load on the arc-length span `[s0, s1]` (those of
+    /// [`TubeStructure::line_cells`]): each element's overlap with the span, of length `ℓ`
+    /// and centroid `c`, is shared between its end nodes `a`, `b` as `ℓ (s_b − c)/(s_b − s_a)`
+    /// and `ℓ (c − s_a)/(s_b − s_a)` (`∫ N_a`, `∫ N_b`: same resultant and same first moment
+    /// as the uniform load).
+    pub fn line_nodes(&self, basis: &TubeBasis, s0: f64, s1: f64) -> Vec<LineNode> {
+        let (rows, cells) = self.line_cells(s0, s1);
+        let mut nodes: Vec<LineNode> = rows
+            .iter()
+            .map(|&node| {
+                let pt = NamedPoint {
+                    name: String::new(),
+                    node,
+                    offset: Vector3::zeros(),
+                };
+                LineNode {
+                    s: 0.0,
+                    weight: 0.0,
+                    rows: point_rows(&basis.assembled, &basis.modes.shapes, &pt),
+                }
+            })
+            .collect();
+        for cell in &cells {
+            let ([sa, sb], [lo, hi]) = (cell.ends, cell.loaded);
+            let (l, c) = (hi - lo, 0.5 * (lo + hi));
+            let [a, b] = cell.nodes;
+            nodes[a].s = sa;
+            nodes[b].s = sb;
+            nodes[a].weight += l * (sb - c) / (sb - sa);
+            nodes[b].weight += l * (c - sa) / (sb - sa);
+        }
+        nodes
+    }
+}
+
+/// Rows (3 × p) of a named point from shapes (n × p) over the reduced DOFs:
+/// `u + θ × r` with `r` the point's offset; a restrained DOF contributes nothing.
+fn point_rows(assembled: &Assembled, shapes: &DMatrix<f64>, pt: &NamedPoint) -> Vec<f64> {
+    let p = shapes.ncols();
+    let dof_row = |d: Dof| -> Option<usize> { assembled.reduced_index(pt.node, d) };
+    let mut rows = vec![0.0; 3 * p];
+    let r = pt.offset;
+    let [ux, uy, uz, rx, ry, rz] =
+        [Dof::Ux, Dof::Uy, Dof::Uz, Dof::Rx, Dof::Ry, Dof::Rz].map(dof_row);
+    let value = |row: Option<usize>, mode: usize| row.map_or(0.0, |i| shapes[(i, mode)]);
+    for m in 0..p {
+        let (tx, ty, tz) = (value(rx, m), value(ry, m), value(rz, m));
+        // θ × r
+        let (cx, cy, cz) = (
+            ty * r.z - tz * r.y,
+            tz * r.x - tx * r.z,
+            tx * r.y - ty * r.x,
+        );
+        rows[m] = value(ux, m) + cx;
+        rows[p + m] = value(uy, m) + cy;
+        rows[2 * p + m] = value(uz, m) + cz;
+    }
+    rows
+}
+
+/// Rotation rows (3 × p) of a node: `θx, θy, θz` of each mode (0 where restrained).
+fn rotation_rows(assembled: &Assembled, shapes: &DMatrix<f64>, node: usize) -> Vec<f64> {
+    let p = shapes.ncols();
+    let mut rows = vec![0.0; 3 * p];
+    for (d, dof) in [Dof::Rx, Dof::Ry, Dof::Rz].into_iter().enumerate() {
+        if let Some(i) = assembled.reduced_index(node, dof) {
+            for m in 0..p {
+                rows[d * p + m] = shapes[(i, m)];
+            }
+        }
+    }
+    rows
+}
+
+/// The node where a point given by its position sits; an error names `field` when no node is
+/// within `tolerance` of it.
+pub fn node_at(mesh: &Mesh, at: &Vector3<f64>, tolerance: f64, field: &str) -> Result<usize> {
+    let (node, distance) = mesh.nearest_node(at);
+    if distance <= tolerance {
+        Ok(node)
+    } else {
+        let x = mesh.nodes[node];
+        Err(Error::invalid(
+            field,
+            format!(
+                "no node at [{}, {}, {}]: the nearest is {distance:.3e} m away, at [{:.6}, {:.6}, {:.6}]; put the point on a node (a path vertex, or a multiple of the mesh size along a segment)",
+                at.x, at.y, at.z, x.x, x.y, x.z
+            ),
+        ))
+    }
+}
