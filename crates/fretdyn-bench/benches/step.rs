@@ -3,23 +3,10 @@
 //! Run: cargo bench -p fretdyn-bench --bench step
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use fretdyn::apps::benchmark::rattling_tube;
+use fretdyn::apps::benchmark::{methods, rattling_tube};
 use fretdyn::apps::verification::V1;
-use fretdyn::contact::tangential::{
-    ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
-};
+use fretdyn::contact::tangential::StickVelocity;
 use fretdyn::integrator::simulation::simulate;
-
-fn methods() -> [TangentialMethod; 3] {
-    [
-        TangentialMethod::Penalty(PenaltySettings {
-            stiffness: 1e6,
-            damping: 2000.0,
-        }),
-        TangentialMethod::ActiveSet(ActiveSetSettings::default()),
-        TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
-    ]
-}
 
 fn v1(c: &mut Criterion) {
     let mut group = c.benchmark_group("v1a_4000_steps");

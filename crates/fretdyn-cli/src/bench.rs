@@ -1,11 +1,9 @@
 //! `fretdyn bench`: steps per second of V1 and of the synthetic rattling tube, per method.
 
-use fretdyn::apps::benchmark::rattling_tube;
+use fretdyn::apps::benchmark::{methods, rattling_tube};
 use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
-use fretdyn::contact::tangential::{
-    ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
-};
+use fretdyn::contact::tangential::StickVelocity;
 use fretdyn::integrator::simulation::simulate;
 
 use std::path::Path;
@@ -15,17 +13,6 @@ use crate::out::outln;
 use crate::plot::{Series, panels_plot};
 
 /// Entry point of `fretdyn bench`.
-fn methods() -> [TangentialMethod; 3] {
-    [
-        TangentialMethod::Penalty(PenaltySettings {
-            stiffness: 1e6,
-            damping: 2000.0,
-        }),
-        TangentialMethod::ActiveSet(ActiveSetSettings::default()),
-        TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
-    ]
-}
-
 pub fn main(steps: u64, repeat: usize, modes: usize, contacts: usize) -> Result<(), Failure> {
     let methods = methods();
     outln!(

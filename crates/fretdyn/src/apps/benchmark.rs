@@ -7,7 +7,9 @@ use nalgebra::Vector3;
 use crate::case::Case;
 use crate::contact::friction::Coulomb;
 use crate::contact::obstacle::{Obstacle, Plane};
-use crate::contact::tangential::{StickVelocity, TangentialMethod};
+use crate::contact::tangential::{
+    ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
+};
 use crate::contact::{Contact, NormalLaw};
 use crate::integrator::simulation::RunSettings;
 use crate::integrator::stability::stable_time_step;
@@ -20,6 +22,20 @@ const LENGTH: f64 = 2.0;
 const BENDING_STIFFNESS: f64 = 498.0; // E I, N·m²
 const MASS_PER_LENGTH: f64 = 1.0; // tube + inner water + added mass, kg/m
 const AXIAL_STIFFNESS: f64 = 1.23e7; // E A, N
+
+/// The three tangential methods the benchmarks compare: the penalty law (`K_T = 1e6 N/m`,
+/// `C_T = 2000 kg/s`, THEORY §4.1), the Active Set (§4.3) and Gauss–Seidel (§4.4) with their
+/// default settings.
+pub fn methods() -> [TangentialMethod; 3] {
+    [
+        TangentialMethod::Penalty(PenaltySettings {
+            stiffness: 1e6,
+            damping: 2000.0,
+        }),
+        TangentialMethod::ActiveSet(ActiveSetSettings::default()),
+        TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
+    ]
+}
 
 /// A pinned tube of length 2 m with `modes` modes (4 axial, the rest bending, half per plane)
 /// and `contacts` plane supports spread along it, alternating ±y and ±z, 0.1 mm clearance,
