@@ -3,6 +3,9 @@
 //! for) and says how to fix it. Models that would not fit in memory are refused with the
 //! figure before anything is allocated.
 
+mod common;
+use common::TempDir;
+
 use std::path::{Path, PathBuf};
 
 use fretdyn::Error;
@@ -36,25 +39,6 @@ fn invalid_in(text: &str, base: &Path) -> (String, String) {
 
 fn invalid(text: &str) -> (String, String) {
     invalid_in(text, Path::new("."))
-}
-
-/// A fresh scratch folder, removed at the end.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("fretdyn-bad-input-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Self(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 // ---------------------------------------------------------------------------------------------
