@@ -9,6 +9,11 @@ NaN), and `summary.json` identical but for what measures the machine (wall time,
 each study file (`base = ...`): `fretdyn sweep` with both, and `study.csv` identical but for its
 wall-time and steps/s columns. Prints one line per example and exits 1 if any differs.
 
+With `--rtol X`, a change that alters round-off only (a different summation order) is measured
+instead: each example prints the largest relative difference of its arrays (max |Δ| / max |x| of
+each array) and of the numbers of its summary (|Δ| / max(|a|, |b|)), and passes when it is at
+most X.
+
 Use it to show that a refactoring changed no result: build the old revision into one target
 folder (`git worktree add /tmp/old REV && cargo build --release --manifest-path /tmp/old/Cargo.toml`)
 and compare with the new build.
@@ -59,6 +64,37 @@ def first_difference(a, b, path="summary"):
     return None if a == b else f"{path}: {a!r} != {b!r}"
 
 
+def worst_relative(a, b, path="summary"):
+    """Largest relative difference between two JSON values of the same shape, and where."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        best = (0.0, None)
+        for k in sorted(set(a) & set(b)):
+            best = max(best, worst_relative(a[k], b[k], f"{path}.{k}"), key=lambda x: x[0])
+        return best
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        best = (0.0, None)
+        for i, (x, y) in enumerate(zip(a, b)):
+            best = max(best, worst_relative(x, y, f"{path}[{i}]"), key=lambda x: x[0])
+        return best
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)) and not isinstance(a, bool):
+        scale = max(abs(a), abs(b))
+        return ((abs(a - b) / scale if scale > 0 else 0.0), path)
+    return (0.0, None) if a == b else (float("inf"), path)
+
+
+def relative_npz(a, b):
+    ra, rb = np.load(a), np.load(b)
+    best = (0.0, None)
+    for key in ra.files:
+        x, y = ra[key].astype(float), rb[key].astype(float)
+        if x.shape != y.shape:
+            return (float("inf"), key)
+        scale = np.nanmax(np.abs(x)) if x.size else 0.0
+        d = np.nanmax(np.abs(x - y)) if x.size else 0.0
+        best = max(best, ((d / scale) if scale > 0 else 0.0, key), key=lambda t: t[0])
+    return best
+
+
 def compare_npz(a, b):
     ra, rb = np.load(a), np.load(b)
     if sorted(ra.files) != sorted(rb.files):
@@ -90,6 +126,7 @@ def main():
     ap.add_argument("new", type=pathlib.Path)
     ap.add_argument("--out", type=pathlib.Path, default=ROOT / "target" / "compare_examples")
     ap.add_argument("--only", nargs="*", help="example stems to compare (default: all)")
+    ap.add_argument("--rtol", type=float, help="measure relative differences, pass at most this")
     args = ap.parse_args()
     failures = 0
     for case in sorted((ROOT / "examples").glob("*.toml")):
@@ -116,6 +153,16 @@ def main():
                                  for r in csv.DictReader(f)])
             rows = [sorted(r, key=lambda x: json.dumps(x, sort_keys=True)) for r in rows]
             diff = None if rows[0] == rows[1] else "study.csv differs"
+        elif args.rtol is not None:
+            s = [strip_machine(json.loads((d / "summary.json").read_text())) for d in dirs]
+            arrays = relative_npz(dirs[0] / "results.npz", dirs[1] / "results.npz")
+            summary = worst_relative(s[0], s[1])
+            worst = max(arrays, summary, key=lambda t: t[0])
+            ok = worst[0] <= args.rtol
+            print(f"{case.name}: {'ok' if ok else 'DIFFERENT'}: largest relative difference "
+                  f"{worst[0]:.1e} ({worst[1]}); arrays {arrays[0]:.1e}, summary {summary[0]:.1e}")
+            failures += not ok
+            continue
         else:
             diff = compare_npz(dirs[0] / "results.npz", dirs[1] / "results.npz")
             if diff is None:

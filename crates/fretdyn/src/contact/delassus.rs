@@ -16,7 +16,7 @@
 
 use nalgebra::{Matrix2, Vector2, Vector3};
 
-use crate::contact::friction::Slide;
+use crate::contact::friction::{DiagonalBlock, Slide};
 
 /// One closed contact in the tangential problem.
 #[derive(Debug, Clone, Copy, Default)]
@@ -46,7 +46,13 @@ pub struct TangentialProblem {
     h: Vec<f64>,
     /// Right-hand side `b`, by slot rows.
     b: Vec<f64>,
+    /// `H_kk` of each slot, prepared for its local solve.
+    diagonal: Vec<DiagonalBlock>,
     stride: usize,
+    /// The closed contacts of the last singularity test whose `H` was made of fixed rows
+    /// only, and its answer ([`Self::is_singular`]).
+    singular_for: Vec<usize>,
+    singular: Option<bool>,
 }
 
 impl TangentialProblem {
@@ -63,7 +69,10 @@ impl TangentialProblem {
             h_fixed: vec![0.0; rows * rows],
             h: vec![0.0; rows * rows],
             b: vec![0.0; rows],
+            diagonal: vec![DiagonalBlock::default(); contacts],
             stride: rows,
+            singular_for: Vec::with_capacity(contacts),
+            singular: None,
         }
     }
 
@@ -78,6 +87,7 @@ impl TangentialProblem {
         apply_a_inv: impl Fn(&[f64], &mut [f64]),
     ) {
         self.fixed[contact] = false;
+        self.singular = None;
         self.compute_rows(contact, tangents, rows, apply_a_inv);
         self.fixed[contact] = true;
         let p = self.p;
@@ -186,6 +196,7 @@ impl TangentialProblem {
     ) {
         let p = self.p;
         let n = 2 * self.slots.len();
+        let mut vimp = Vector2::zeros();
         for r in 0..n {
             let lr_index = self.contact_row(r);
             let lr = &self.l[lr_index * p..(lr_index + 1) * p];
@@ -200,9 +211,14 @@ impl TangentialProblem {
                 self.h[r * self.stride + c] = v;
                 self.h[c * self.stride + r] = v;
             }
-            let vimp = v_imp(&self.slots[r / 2])[r % 2];
-            self.b[r] = crate::structure::modal::dot(lr, qdd_free)
-                + (crate::structure::modal::dot(lr, qd_star) - vimp) / theta_dt;
+            if r % 2 == 0 {
+                vimp = v_imp(&self.slots[r / 2]);
+            }
+            let (acceleration, velocity) = crate::structure::modal::dot2(lr, qdd_free, qd_star);
+            self.b[r] = acceleration + (velocity - vimp[r % 2]) / theta_dt;
+        }
+        for k in 0..self.slots.len() {
+            self.diagonal[k] = DiagonalBlock::new(self.block(k, k));
         }
     }
 
@@ -223,6 +239,12 @@ impl TangentialProblem {
         )
     }
 
+    /// `H_kk` prepared for its local solve, formed by [`Self::assemble`].
+    #[inline]
+    pub fn diagonal_block(&self, k: usize) -> &DiagonalBlock {
+        &self.diagonal[k]
+    }
+
     /// `b_k`.
     #[inline]
     pub fn rhs(&self, k: usize) -> Vector2<f64> {
@@ -232,13 +254,22 @@ impl TangentialProblem {
     /// `b_k − Σ_{l≠k} H_kl λ_l`: the right-hand side of contact k's local problem.
     #[inline]
     pub fn local_rhs(&self, k: usize, lambda: &[Vector2<f64>]) -> Vector2<f64> {
-        let mut c = self.rhs(k);
-        for (l, lam) in lambda.iter().enumerate().take(self.slots.len()) {
+        let m = self.slots.len().min(lambda.len());
+        let row0 = &self.h[2 * k * self.stride..][..2 * m];
+        let row1 = &self.h[(2 * k + 1) * self.stride..][..2 * m];
+        let (mut c0, mut c1) = (self.b[2 * k], self.b[2 * k + 1]);
+        for (l, ((lam, h0), h1)) in lambda[..m]
+            .iter()
+            .zip(row0.chunks_exact(2))
+            .zip(row1.chunks_exact(2))
+            .enumerate()
+        {
             if l != k {
-                c -= self.block(k, l) * lam;
+                c0 -= h0[0] * lam.x + h0[1] * lam.y;
+                c1 -= h1[0] * lam.x + h1[1] * lam.y;
             }
         }
-        c
+        Vector2::new(c0, c1)
     }
 
     /// `(b − Hλ)_k`: contact k's tangential velocity relative to the obstacle, divided by θΔt.
@@ -296,11 +327,36 @@ impl TangentialProblem {
 
     /// Whether `H` is singular (redundant constraints, THEORY §4.6): a Cholesky pivot below
     /// `1e-12` of the largest diagonal term. `work` must hold `(2m)² + 4m` values.
-    pub fn is_singular(&self, work: &mut [f64]) -> bool {
+    ///
+    /// When every closed contact's rows are fixed (planes, bars), `H` depends only on which
+    /// contacts are closed: the factorisation is then redone only when that set changes
+    /// (at an impact or a release), and the last answer is given otherwise.
+    pub fn is_singular(&mut self, work: &mut [f64]) -> bool {
         let n = 2 * self.slots.len();
         if n == 0 {
             return false;
         }
+        let all_fixed = self.slots.iter().all(|s| self.fixed[s.contact]);
+        if all_fixed
+            && self.singular.is_some()
+            && self.singular_for.len() == self.slots.len()
+            && self
+                .singular_for
+                .iter()
+                .zip(&self.slots)
+                .all(|(c, s)| *c == s.contact)
+        {
+            return self.singular == Some(true);
+        }
+        let singular = self.factor_singular(work, n);
+        self.singular = all_fixed.then_some(singular);
+        self.singular_for.clear();
+        self.singular_for
+            .extend(self.slots.iter().map(|s| s.contact));
+        singular
+    }
+
+    fn factor_singular(&self, work: &mut [f64], n: usize) -> bool {
         let (a, rest) = work.split_at_mut(n * n);
         let (x, rest) = rest.split_at_mut(n);
         let diag = &mut rest[..n];

@@ -60,6 +60,40 @@ pub enum LocalSolve {
     Radial,
 }
 
+/// A contact's 2 × 2 diagonal block `H_ii` of the Delassus operator with what its local solve
+/// needs of it: its inverse ([`inverse2`]) and its eigen-decomposition, formed once per step
+/// rather than at every sweep.
+#[derive(Debug, Clone, Copy)]
+pub struct DiagonalBlock {
+    /// `H_ii`.
+    pub h: Matrix2<f64>,
+    inverse: Matrix2<f64>,
+    rotation: Matrix2<f64>,
+    eigenvalues: [f64; 2],
+    isotropic: bool,
+}
+
+impl DiagonalBlock {
+    /// The block `h` (symmetric positive semi-definite).
+    #[inline]
+    pub fn new(h: Matrix2<f64>) -> Self {
+        let (rotation, eigenvalues) = symmetric_eigen2(&h);
+        Self {
+            h,
+            inverse: inverse2(&h),
+            rotation,
+            eigenvalues,
+            isotropic: is_isotropic(&h),
+        }
+    }
+}
+
+impl Default for DiagonalBlock {
+    fn default() -> Self {
+        Self::new(Matrix2::zeros())
+    }
+}
+
 /// Solves one contact's tangential problem with the other contacts frozen:
 /// find `λ` such that, with `w = c − H λ` (the slip velocity up to the factor θΔt),
 /// either `w = 0` and `|λ| ≤ s_static` (stick), or `λ = s_dynamic w/|w|` (slip).
@@ -74,45 +108,77 @@ pub fn local_solve(
     s_dynamic: f64,
     mode: LocalSolve,
 ) -> (Vector2<f64>, Slide) {
-    let free = solve2(h, c);
-    if free.norm() <= s_static {
+    local_solve_block(&DiagonalBlock::new(*h), c, s_static, s_dynamic, mode)
+}
+
+/// [`local_solve`] on a block prepared once per step ([`DiagonalBlock`]).
+#[inline]
+pub fn local_solve_block(
+    block: &DiagonalBlock,
+    c: &Vector2<f64>,
+    s_static: f64,
+    s_dynamic: f64,
+    mode: LocalSolve,
+) -> (Vector2<f64>, Slide) {
+    let free = block.inverse * c;
+    let norm = free.norm();
+    if norm <= s_static {
         return (free, Slide::Stick);
     }
     if s_dynamic <= 0.0 {
         return (Vector2::zeros(), Slide::Slip);
     }
     let lambda = match mode {
-        LocalSolve::Radial => free * (s_dynamic / free.norm()),
-        LocalSolve::Exact => disk_boundary_solve(h, c, s_dynamic),
+        LocalSolve::Radial => free * (s_dynamic / norm),
+        LocalSolve::Exact if block.isotropic => free * (s_dynamic / norm),
+        LocalSolve::Exact => disk_boundary_solve(block, c, s_dynamic),
     };
     (lambda, Slide::Slip)
 }
 
-/// `H⁻¹ c` for a 2 × 2 matrix, with a pseudo-inverse fallback when `H` is singular.
+/// `H = h I`: then `(sH + tI)u = c` makes `u` parallel to `c`, hence to `H⁻¹c`, and the exact
+/// slip solution is the radial projection of the free one, in closed form.
 #[inline]
-pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
+fn is_isotropic(h: &Matrix2<f64>) -> bool {
+    h[(0, 1)] == 0.0 && h[(1, 0)] == 0.0 && h[(0, 0)] == h[(1, 1)]
+}
+
+/// `H⁻¹` for a 2 × 2 matrix, or its pseudo-inverse when `H` is singular (a pivot below
+/// `1e-13` of the largest diagonal term: the least-squares solution along the dominant
+/// eigenvector).
+#[inline]
+pub fn inverse2(h: &Matrix2<f64>) -> Matrix2<f64> {
     let det = h[(0, 0)] * h[(1, 1)] - h[(0, 1)] * h[(1, 0)];
     let scale = h[(0, 0)].abs().max(h[(1, 1)].abs());
     if det.abs() > 1e-13 * scale * scale {
-        Vector2::new(
-            (h[(1, 1)] * c.x - h[(0, 1)] * c.y) / det,
-            (h[(0, 0)] * c.y - h[(1, 0)] * c.x) / det,
+        let id = 1.0 / det;
+        Matrix2::new(
+            h[(1, 1)] * id,
+            -h[(0, 1)] * id,
+            -h[(1, 0)] * id,
+            h[(0, 0)] * id,
         )
     } else if scale > 0.0 {
-        // Rank one (or zero): least-squares solution along the dominant eigenvector.
         let eig = h.symmetric_eigen();
-        let mut out = Vector2::zeros();
+        let mut out = Matrix2::zeros();
         for k in 0..2 {
             let e = eig.eigenvalues[k];
             if e.abs() > 1e-13 * scale {
                 let v = eig.eigenvectors.column(k);
-                out += v * (v.dot(c) / e);
+                out += v * v.transpose() / e;
             }
         }
         out
     } else {
-        Vector2::zeros()
+        Matrix2::zeros()
     }
+}
+
+/// `H⁻¹ c` for a 2 × 2 matrix, with a pseudo-inverse fallback when `H` is singular
+/// ([`inverse2`]).
+#[inline]
+pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
+    inverse2(h) * c
 }
 
 /// The slip solution on the circle of radius `s`: `λ = s u`, `|u| = 1`, `(s H + t I) u = c`,
@@ -128,8 +194,8 @@ pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
 /// `c` lies along the stiff eigenvector of an `H` anisotropic by 10³, a tube sliding round a
 /// hole) costs Newton one step down (an earlier version projected radially when the start
 /// was not below the root, off by up to 1e-4 in direction).
-fn disk_boundary_solve(h: &Matrix2<f64>, c: &Vector2<f64>, s: f64) -> Vector2<f64> {
-    let (q, eigenvalues) = symmetric_eigen2(h);
+fn disk_boundary_solve(block: &DiagonalBlock, c: &Vector2<f64>, s: f64) -> Vector2<f64> {
+    let (h, q, eigenvalues) = (&block.h, block.rotation, block.eigenvalues);
     let hs = [s * eigenvalues[0], s * eigenvalues[1]];
     let cp = q.transpose() * c;
     // u(t) in the eigenbasis; a component of c that is exactly 0 stays 0 (also at t = lower).

@@ -5,6 +5,8 @@
 //! Delassus operator ([`delassus`]) solved by the [`tangential`] methods (THEORY §4, §7, §8).
 //!
 //! - [`obstacle`]: planes, bi-planes, circles, polygons: gap, normal, tangent frame;
+//! - [`frame_rows`]: the frame of a plane or bars projected on the modes (detection in one
+//!   dot product);
 //! - [`motion`]: the imposed motion of an obstacle (THEORY §8);
 //! - [`friction`]: Coulomb coefficients, the local stick/slip solve;
 //! - [`delassus`]: the tangential problem `W λ + b` on the closed contacts (THEORY §4.2);
@@ -14,6 +16,7 @@
 //! coefficients) is defined here.
 
 pub mod delassus;
+pub mod frame_rows;
 pub mod friction;
 pub mod motion;
 pub mod obstacle;

@@ -105,6 +105,16 @@ impl Plane {
     pub fn tangents(&self) -> [Vector3<f64>; 2] {
         self.tangents
     }
+
+    /// Reference point `x0`.
+    pub fn origin(&self) -> Vector3<f64> {
+        self.origin
+    }
+
+    /// Clearance `gap`, m.
+    pub fn gap(&self) -> f64 {
+        self.gap
+    }
 }
 
 /// A first tangent for a normal `n`: the global axis least aligned with `n`, projected.
@@ -462,6 +472,17 @@ impl Obstacle {
     /// in-plane offset whose radius and angle are meaningful.
     pub fn is_hole(&self) -> bool {
         matches!(self, Obstacle::Circle(_) | Obstacle::Polygon(_))
+    }
+
+    /// For planes and bars, whose normal never turns: `(n, x0, gap, two-sided)`, with which
+    /// the penetration follows from the signed distance `s = (x − x0)·n` alone
+    /// ([`crate::contact::frame_rows::FrameRows`]).
+    pub fn fixed_normal(&self) -> Option<(Vector3<f64>, Vector3<f64>, f64, bool)> {
+        match self {
+            Obstacle::Plane(p) => Some((p.normal, p.origin, p.gap, false)),
+            Obstacle::BiPlane(b) => Some((b.normal, b.origin, b.gap, true)),
+            Obstacle::Circle(_) | Obstacle::Polygon(_) => None,
+        }
     }
 
     /// The tangent basis, when it does not depend on the position or time (fixed planes and

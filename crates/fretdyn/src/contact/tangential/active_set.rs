@@ -22,7 +22,7 @@ use nalgebra::Vector2;
 
 use super::{ActiveSetSettings, SolverStatistics, gauss_seidel};
 use crate::contact::delassus::TangentialProblem;
-use crate::contact::friction::{LocalSolve, Slide, local_solve};
+use crate::contact::friction::{LocalSolve, Slide, local_solve_block};
 
 /// Memory of a contact between steps: its last status and slip direction.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -131,8 +131,8 @@ impl ActiveSet {
             for (k, slot) in problem.slots().iter().enumerate() {
                 // contact k's exact local problem, the others frozen
                 let local = |lambda: &[Vector2<f64>]| {
-                    local_solve(
-                        &problem.block(k, k),
+                    local_solve_block(
+                        problem.diagonal_block(k),
                         &problem.local_rhs(k, lambda),
                         slot.s_static,
                         slot.s_dynamic,

@@ -12,7 +12,7 @@ use nalgebra::Vector2;
 
 use super::GaussSeidelSettings;
 use crate::contact::delassus::TangentialProblem;
-use crate::contact::friction::{LocalSolve, Slide, local_solve};
+use crate::contact::friction::{LocalSolve, Slide, local_solve_block};
 
 /// Result of one solve.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,8 +39,8 @@ pub fn solve(
         let mut norm2 = 0.0;
         for (k, slot) in problem.slots().iter().enumerate() {
             let c = problem.local_rhs(k, &lambda[..m]);
-            let (new, st) = local_solve(
-                &problem.block(k, k),
+            let (new, st) = local_solve_block(
+                problem.diagonal_block(k),
                 &c,
                 slot.s_static,
                 slot.s_dynamic,

@@ -5,13 +5,14 @@ use super::{ContactState, RunResults, Simulation, Termination};
 use crate::contact::friction::Slide;
 use crate::results::recorder::{ContactSample, Recorder};
 use crate::results::statistics::StepValues;
-use crate::structure::modal::dot;
+use crate::contact::frame_rows::FrameRows;
+use crate::structure::modal::recombine;
 
 impl Simulation<'_> {
     /// Energy `E` and the powers `[external (loads and moving obstacles), modal damping,
     /// contact damping, tangential]`.
     pub(super) fn energy_and_powers(&self) -> (f64, [f64; 4]) {
-        let mut e = self.cd.energy();
+        let (mut e, modal_damping, external) = self.cd.energy_and_powers(&self.external);
         let mut contact_damping = 0.0;
         let mut tangential = 0.0;
         let mut obstacle = 0.0;
@@ -19,19 +20,22 @@ impl Simulation<'_> {
             if s.closed {
                 let d = s.frame.penetration;
                 e += 0.5 * c.normal.stiffness * d * d;
-                let rate = -s.frame.normal.dot(&s.v);
-                contact_damping += (s.normal_force - c.normal.stiffness * d) * rate;
+                if c.normal.damping > 0.0 {
+                    // (R_N − K_N δ) δ̇: zero without damping
+                    contact_damping += (s.normal_force - c.normal.stiffness * d) * -s.v_normal;
+                }
                 tangential -= s.tangential_force.dot(&s.tangential_velocity());
-                // a moving obstacle works on the structure at the rate R·v_obstacle
-                obstacle += s.force().dot(&s.frame.velocity);
+                if !c.motion.is_fixed() {
+                    // a moving obstacle works on the structure at the rate R·v_obstacle
+                    obstacle += s.force().dot(&s.frame.velocity);
+                }
             }
         }
-        let external = dot(&self.external, &self.cd.qd) + obstacle;
         (
             e,
             [
-                external,
-                self.cd.damping_power(),
+                external + obstacle,
+                modal_damping,
                 contact_damping,
                 tangential,
             ],
@@ -47,7 +51,12 @@ impl Simulation<'_> {
             return None;
         }
         let mut non_finite = None;
-        for (k, (s, c)) in self.contacts.iter().zip(&self.model.contacts).enumerate() {
+        for (k, (s, c)) in self.contacts.iter_mut().zip(&self.model.contacts).enumerate() {
+            if self.frame_rows[k].is_some() {
+                // a plane's or bars' 3-D position is formed for the samples only
+                let pt = &self.model.basis.points[c.point];
+                s.x = pt.coords + recombine(&pt.rows, &self.cd.q);
+            }
             let vt = s.tangential_velocity();
             let local = c.local(&s.x, t);
             // a sum is non-finite when a term is (or when it overflows: no value to keep)
@@ -116,9 +125,17 @@ impl Simulation<'_> {
 
 /// One contact's values of the step ending at `t`, for the statistics (THEORY §5).
 #[inline]
-pub(super) fn step_values(s: &ContactState, c: &crate::contact::Contact, t: f64) -> StepValues {
-    let local = c.local(&s.x, t);
-    let (radial, direction) = if c.obstacle.is_hole() {
+pub(super) fn step_values(
+    s: &ContactState,
+    c: &crate::contact::Contact,
+    rows: Option<&FrameRows>,
+    t: f64,
+) -> StepValues {
+    let (radial, direction) = if rows.is_some() {
+        // a plane or bars: the distance from the (mid-)plane, THEORY §5
+        (s.distance, [1.0, 0.0])
+    } else if c.obstacle.is_hole() {
+        let local = c.local(&s.x, t);
         let r = local.norm();
         let unit = if r > 0.0 {
             [local.x / r, local.y / r]
@@ -127,7 +144,7 @@ pub(super) fn step_values(s: &ContactState, c: &crate::contact::Contact, t: f64)
         };
         (r, unit)
     } else {
-        (local.x, [1.0, 0.0])
+        (c.local(&s.x, t).x, [1.0, 0.0])
     };
     let (slip_speed, friction_power) = if s.closed {
         let vt = s.tangential_velocity();

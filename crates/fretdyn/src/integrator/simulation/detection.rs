@@ -1,44 +1,55 @@
 //! Phase 1 of a step — the loads and the kinematics: the external modal force at `t`, the
-//! contact points' positions, frames and velocities, and the normal penalty forces that
+//! contact points' penetrations, frames and velocities, and the normal penalty forces that
 //! follow from them (THEORY §2 step 3, §3, §7, §8); after the step, the full-step
 //! velocities.
+//!
+//! A plane or bars ([`FrameRows`]) is detected with one dot product on the modal
+//! displacements; other obstacles (holes) from the point's 3-D position. Velocities are
+//! formed for closed contacts only (and for every contact at an output sample), in the
+//! contact's frame.
 
 use nalgebra::{Vector2, Vector3};
 
-use super::{Simulation, Tangential, contact_rows, contact_states};
-use crate::structure::modal::recombine;
+use super::{ContactState, Simulation, Tangential, contact_rows, contact_states};
+use crate::contact::Contact;
+use crate::contact::frame_rows::FrameRows;
+use crate::structure::modal::{axpy, recombine};
 
 impl Simulation<'_> {
     pub(super) fn external_force(&mut self, t: f64) {
         let p = self.external.len();
-        self.external.iter_mut().for_each(|f| *f = 0.0);
         let histories = self.model.loads.iter().map(|l| &l.history);
         let modal = self.model.modal_loads.iter().map(|l| &l.history);
         let base = self.model.base_acceleration.iter().map(|b| &b.history);
-        for (l, history) in histories.chain(modal).chain(base).enumerate() {
-            let s = history.value(t);
-            for (f, g) in self
-                .external
-                .iter_mut()
-                .zip(&self.load_rows[l * p..(l + 1) * p])
-            {
-                *f += s * g;
+        let mut rows = self
+            .load_rows
+            .chunks_exact(p.max(1))
+            .zip(histories.chain(modal).chain(base));
+        // the first load sets the force, the others add to it
+        match rows.next() {
+            Some((row, history)) => {
+                let s = history.value(t);
+                for (f, g) in self.external.iter_mut().zip(row) {
+                    *f = s * g;
+                }
             }
+            None => self.external.fill(0.0),
+        }
+        for (row, history) in rows {
+            axpy(&mut self.external, history.value(t), row);
         }
         for (load, generator) in self.model.turbulence.iter().zip(&mut self.turbulence) {
             let r = generator.channels();
             let xi = &mut self.signals[..r];
             generator.values(t, xi);
-            for (j, x) in xi.iter().enumerate() {
-                for (f, g) in self.external.iter_mut().zip(&load.rows[j * p..(j + 1) * p]) {
-                    *f += x * g;
-                }
+            for (x, row) in xi.iter().zip(load.rows.chunks_exact(p.max(1))) {
+                axpy(&mut self.external, *x, row);
             }
         }
     }
 
-    /// Step 3: positions, velocities (predicted when `predicted`), frames and normal forces
-    /// at time `t`.
+    /// Step 3: penetrations, frames, velocities (predicted when `predicted`) and normal
+    /// forces at time `t`.
     pub(super) fn detect(&mut self, t: f64, predicted: bool) {
         let velocity = if predicted {
             &self.cd.qd_star
@@ -46,31 +57,51 @@ impl Simulation<'_> {
             &self.cd.qd
         };
         let p = self.cd.q.len();
+        let penalty = matches!(self.tangential, Tangential::Penalty { .. });
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
-            let pt = &self.model.basis.points[c.point];
-            state.x = pt.coords + recombine(&pt.rows, &self.cd.q);
-            state.frame = c.frame(&state.x, t);
-            state.closed = state.frame.penetration > 0.0;
             state.tangential_force = Vector2::zeros();
             state.held = false;
-            if state.closed {
-                // an open contact's velocity is only needed at output samples
-                let rows = if c.at_surface() {
-                    let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
-                    c.surface_rows(pt, &state.frame.normal, out);
-                    &*out
-                } else {
-                    &pt.rows[..]
-                };
-                state.v = recombine(rows, velocity) - state.frame.velocity;
-                let rate = -state.frame.normal.dot(&state.v);
-                state.normal_force = c.normal.force(state.frame.penetration, rate);
-                if matches!(self.tangential, Tangential::Penalty { .. }) {
-                    let (d, _) = c.motion.at(t);
-                    state.x_relative = pt.coords + recombine(rows, &self.cd.q) - d;
+            let pt = &self.model.basis.points[c.point];
+            match &self.frame_rows[k] {
+                Some(rows) => {
+                    state.distance = rows.distance(&self.cd.q, &c.motion, t);
+                    rows.update(state.distance, &mut state.frame);
                 }
-            } else {
+                None => {
+                    state.x = pt.coords + recombine(&pt.rows, &self.cd.q);
+                    state.frame = c.frame(&state.x, t);
+                }
+            }
+            state.closed = state.frame.penetration > 0.0;
+            if !state.closed {
                 state.normal_force = 0.0;
+                continue;
+            }
+            // an open contact's velocity is only needed at output samples
+            if !c.motion.is_fixed() {
+                state.frame.velocity = c.motion.at(t).1;
+            }
+            match &self.frame_rows[k] {
+                Some(frame_rows) => {
+                    state.set_velocity(Kinematics::Rows(frame_rows), c, velocity, penalty);
+                }
+                None => {
+                    let rows = if c.at_surface() {
+                        let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
+                        c.surface_rows(pt, &state.frame.normal, out);
+                        &*out
+                    } else {
+                        &pt.rows[..]
+                    };
+                    state.set_velocity(Kinematics::Point(rows), c, velocity, penalty);
+                }
+            }
+            state.normal_force = c.normal.force(state.frame.penetration, -state.v_normal);
+            if penalty {
+                // the anchor of the penalty law lives in the obstacle's frame
+                let (d, _) = c.motion.at(t);
+                let rows = contact_rows(self.model, &self.surface_rows, k);
+                state.x_relative = pt.coords + recombine(rows, &self.cd.q) - d;
             }
         }
     }
@@ -84,17 +115,73 @@ impl Simulation<'_> {
     pub(super) fn full_step_velocities(&mut self, all: bool) {
         let p = self.cd.q.len();
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
-            if state.closed || all {
-                let pt = &self.model.basis.points[c.point];
-                if c.at_surface() && !state.closed {
-                    let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
-                    c.surface_rows(pt, &state.frame.normal, out);
+            if !(state.closed || all) {
+                continue;
+            }
+            if !c.motion.is_fixed() {
+                state.frame.velocity = moving_full_step(&c.motion, self.step, self.settings.dt);
+            }
+            match &self.frame_rows[k] {
+                Some(rows) => state.set_velocity(Kinematics::Rows(rows), c, &self.cd.qd, true),
+                None => {
+                    let pt = &self.model.basis.points[c.point];
+                    if c.at_surface() && !state.closed {
+                        let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
+                        c.surface_rows(pt, &state.frame.normal, out);
+                    }
+                    let rows = contact_rows(self.model, &self.surface_rows, k);
+                    state.set_velocity(Kinematics::Point(rows), c, &self.cd.qd, true);
                 }
-                let rows = contact_rows(self.model, &self.surface_rows, k);
-                if !c.motion.is_fixed() {
-                    state.frame.velocity = moving_full_step(&c.motion, self.step, self.settings.dt);
+            }
+        }
+    }
+}
+
+/// How a contact's velocity is formed from the modal velocities.
+pub(super) enum Kinematics<'a> {
+    /// A plane or bars: its frame rows.
+    Rows(&'a FrameRows),
+    /// Any obstacle: the contact point's 3 × p rows.
+    Point(&'a [f64]),
+}
+
+impl ContactState {
+    /// Sets the velocity relative to the obstacle, in the frame, for modal velocities `qd`
+    /// (the frame's velocity is the obstacle's). The normal component is formed only when
+    /// the normal law has damping, the only use of it (`R_N = K_N δ + C_N δ̇`, THEORY §3); it
+    /// is 0 otherwise. The tangential one only when `tangential` (the predicted tangential
+    /// velocity serves the penalty law only: the Lagrange methods form `L q̇*` themselves).
+    #[inline]
+    pub(super) fn set_velocity(
+        &mut self,
+        kinematics: Kinematics,
+        c: &Contact,
+        qd: &[f64],
+        tangential: bool,
+    ) {
+        let damped = c.normal.damping > 0.0;
+        match kinematics {
+            Kinematics::Rows(rows) => {
+                if tangential {
+                    self.v_tangential = rows.tangential_velocity(qd, &self.frame.velocity);
                 }
-                state.v = recombine(rows, &self.cd.qd) - state.frame.velocity;
+                self.v_normal = if damped {
+                    rows.normal_velocity(&self.frame, qd, &self.frame.velocity)
+                } else {
+                    0.0
+                };
+            }
+            Kinematics::Point(rows) => {
+                if !(tangential || damped) {
+                    return;
+                }
+                let v = recombine(rows, qd) - self.frame.velocity;
+                let f = &self.frame;
+                self.v_normal = if damped { f.normal.dot(&v) } else { 0.0 };
+                if tangential {
+                    self.v_tangential =
+                        Vector2::new(f.tangents[0].dot(&v), f.tangents[1].dot(&v));
+                }
             }
         }
     }

@@ -30,6 +30,7 @@ use tangential::{LagrangeSolver, Tangential};
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
+use crate::contact::frame_rows::FrameRows;
 use crate::contact::friction::Slide;
 use crate::contact::obstacle::ContactFrame;
 use crate::contact::tangential::active_set::{ActiveSet, History};
@@ -81,14 +82,20 @@ impl Snapshot {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 struct ContactState {
     frame: ContactFrame,
-    /// Physical position of the point.
+    /// Physical position of the point: updated at every step for a hole, at output samples
+    /// only for a plane or bars (whose detection needs [`Self::distance`] only).
     x: Vector3<f64>,
+    /// Plane or bars ([`FrameRows`]): the signed distance `s = (x − d(t) − x₀)·n`.
+    distance: f64,
     /// Position of the contact point (on the surface for a tube contact) relative to the
     /// moving obstacle: the penalty law's anchor lives in this frame.
     x_relative: Vector3<f64>,
-    /// Point velocity relative to the obstacle (predicted during the step, full-step after;
-    /// see [`Simulation::full_step_velocities`]).
-    v: Vector3<f64>,
+    /// Velocity of the point relative to the obstacle along the frame's normal (predicted
+    /// during the step, full-step after; see [`Simulation::full_step_velocities`]); formed
+    /// only when the normal law has damping, 0 otherwise.
+    v_normal: f64,
+    /// Its tangential velocity relative to the obstacle, tangent basis.
+    v_tangential: Vector2<f64>,
     normal_force: f64,
     /// Tangential force of the obstacle on the structure, tangent basis.
     tangential_force: Vector2<f64>,
@@ -119,10 +126,7 @@ impl ContactState {
         if self.held {
             return Vector2::zeros();
         }
-        Vector2::new(
-            self.frame.tangents[0].dot(&self.v),
-            self.frame.tangents[1].dot(&self.v),
-        )
+        self.v_tangential
     }
 
     /// True when `R_N² + |R_T|² + δ² + |v|²` (`v` of a closed contact only: an open one's is
@@ -135,7 +139,7 @@ impl ContactState {
     #[inline]
     fn accumulable(&self, bound: f64) -> bool {
         let v2 = if self.closed {
-            self.v.norm_squared()
+            self.v_normal * self.v_normal + self.v_tangential.norm_squared()
         } else {
             0.0
         };
@@ -165,8 +169,11 @@ pub struct Simulation<'m> {
     contacts: Vec<ContactState>,
     tangential: Tangential,
     /// Rows (3 × p) of the contact points on the tube surface, one block per contact (used
-    /// only by contacts with a radius), updated with the normal at each step.
+    /// only by contacts with a radius), updated with the normal at each step (once for a
+    /// plane).
     surface_rows: Vec<f64>,
+    /// Per contact: the frame rows of a plane or bars, `None` for a hole.
+    frame_rows: Vec<Option<FrameRows>>,
     /// Modal loads `Φ_lᵀ F_l`, one row of p per load.
     load_rows: Vec<f64>,
     /// Signal generators of the turbulent loads, one per load.
@@ -439,21 +446,44 @@ impl<'m> Simulation<'m> {
                 velocity: Vector3::zeros(),
             },
             x: Vector3::zeros(),
+            distance: 0.0,
             x_relative: Vector3::zeros(),
-            v: Vector3::zeros(),
+            v_normal: 0.0,
+            v_tangential: Vector2::zeros(),
             normal_force: 0.0,
             tangential_force: Vector2::zeros(),
             closed: false,
             slide: Slide::Stick,
             held: false,
         };
+        let frame_rows: Vec<Option<FrameRows>> = model
+            .contacts
+            .iter()
+            .map(|c| FrameRows::new(c, &model.basis.points[c.point]))
+            .collect();
+        let mut surface_rows = vec![0.0; 3 * p * nc];
+        let mut contacts = vec![blank; nc];
+        for (k, (c, rows)) in model.contacts.iter().zip(&frame_rows).enumerate() {
+            if let Some(rows) = rows {
+                contacts[k].frame = rows.frame(0.0);
+                if c.at_surface() {
+                    // a plane: the normal, and so the surface rows, never change
+                    c.surface_rows(
+                        &model.basis.points[c.point],
+                        &contacts[k].frame.normal,
+                        &mut surface_rows[3 * p * k..3 * p * (k + 1)],
+                    );
+                }
+            }
+        }
         Ok(Self {
             model,
             settings,
             cd,
-            contacts: vec![blank; nc],
+            contacts,
             tangential,
-            surface_rows: vec![0.0; 3 * p * nc],
+            surface_rows,
+            frame_rows,
             load_rows,
             turbulence,
             signals: vec![0.0; channels],
@@ -476,6 +506,7 @@ impl<'m> Simulation<'m> {
         self.detect(0.0, false);
         self.contact_forces();
         self.cd.start(&self.force);
+        self.full_step_velocities(true);
         for c in &mut self.contacts {
             // the velocities were the initial (full-step) ones already
             if c.closed && c.tangential_force == Vector2::zeros() {
@@ -493,7 +524,6 @@ impl<'m> Simulation<'m> {
                 .iter()
                 .map(|c| (c.frame.penetration, c.closed)),
         );
-        self.full_step_velocities(true);
         // the initial state is the input's: the steps check what they add
         let _ = self.sample();
     }
@@ -554,7 +584,8 @@ impl<'m> Simulation<'m> {
             .contacts
             .iter()
             .zip(&model.contacts)
-            .map(|(s, c)| step_values(s, c, t));
+            .zip(&self.frame_rows)
+            .map(|((s, c), rows)| step_values(s, c, rows.as_ref(), t));
         self.statistics
             .step(&self.settings.statistics, &self.names, t, dt, values);
         Ok(())

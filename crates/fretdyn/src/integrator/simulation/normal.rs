@@ -26,12 +26,19 @@ impl Simulation<'_> {
                 }
             }
             if state.closed {
-                let f = state.force();
-                project_add(
-                    contact_rows(self.model, &self.surface_rows, k),
-                    &f,
-                    &mut self.force,
-                );
+                match &self.frame_rows[k] {
+                    Some(rows) => rows.project_add(
+                        &state.frame.normal,
+                        state.normal_force,
+                        &state.tangential_force,
+                        &mut self.force,
+                    ),
+                    None => project_add(
+                        contact_rows(self.model, &self.surface_rows, k),
+                        &state.force(),
+                        &mut self.force,
+                    ),
+                }
             }
         }
     }
