@@ -157,7 +157,7 @@ fn bench_case(case: &Case, repeat: usize) -> Result<(), Failure> {
     Ok(())
 }
 
-fn cpu_model() -> String {
+pub(crate) fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {

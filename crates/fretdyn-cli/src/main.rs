@@ -1,5 +1,6 @@
 //! The `fretdyn` command: run case files, verify against the analytic solutions, benchmark.
 
+mod against_c;
 mod bench;
 mod modes;
 mod out;
@@ -99,11 +100,14 @@ enum Command {
         #[arg(long, default_value_t = 4)]
         shown: usize,
     },
-    /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube.
+    /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube (or, with
+    /// --against-c, side by side with a plain C implementation of the step).
     Bench {
-        /// Steps per run of the synthetic tube (V1 runs its 4000 steps, 20 × repeat times).
-        #[arg(long, default_value_t = 200_000)]
-        steps: u64,
+        /// Steps per run of the synthetic tube [default: 200000] (V1 runs its 4000 steps, 20 ×
+        /// repeat times). With --against-c: the steps of every timed run of both programs,
+        /// instead of 200000 on S1 and 50000 on the grid (for a quick check; not with --write).
+        #[arg(long)]
+        steps: Option<u64>,
         /// Repetitions; the best is reported.
         #[arg(long, default_value_t = 3)]
         repeat: usize,
@@ -115,8 +119,26 @@ enum Command {
         contacts: usize,
         /// Instead: the cost of a step over 10–200 modes × 1–50 contacts, per method, as a
         /// table, `scaling.csv` and `scaling.png` in this folder.
-        #[arg(long, value_name = "DIR", value_parser = path)]
+        #[arg(long, value_name = "DIR", value_parser = path, conflicts_with = "against_c")]
         scaling: Option<PathBuf>,
+        /// Instead: time fretdyn's step against the plain C one of DIR/step_ref.c (built with
+        /// gcc) on case S1 and on a grid of 10–200 modes × 1–50 contacts, after checking that
+        /// the two agree after 2000 steps; DIR is the perf folder, e.g. ../shared/perf. Takes
+        /// minutes; prints a markdown report.
+        #[arg(long, value_name = "DIR", value_parser = path)]
+        against_c: Option<PathBuf>,
+        /// With --against-c: interleaved pairs (C, fretdyn) per timed case; medians are
+        /// reported. At least 5 with --write.
+        #[arg(long, default_value_t = 5, requires = "against_c")]
+        reps: usize,
+        /// With --against-c: only case S1 (seconds) or only the grid (minutes).
+        #[arg(long, value_enum, requires = "against_c")]
+        only: Option<against_c::Part>,
+        /// With --against-c: also put the report in this markdown file, between the lines
+        /// `<!-- against-c:begin -->` and `<!-- against-c:end -->` (appended with them when
+        /// they are absent).
+        #[arg(long, value_name = "FILE", value_parser = path, requires = "against_c")]
+        write: Option<PathBuf>,
     },
 }
 
@@ -148,12 +170,22 @@ fn command_line_error(e: clap::Error) -> ExitCode {
         return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
     }
     let text = e.render().to_string();
-    let first = text
-        .lines()
+    let mut lines = text.lines();
+    let mut first = lines
         .next()
         .unwrap_or_default()
         .trim_start_matches("error: ")
-        .trim();
+        .trim()
+        .to_string();
+    // the indented lines right after it belong to it: the missing arguments of "the following
+    // required arguments were not provided:", the "[possible values: …]" of an invalid value
+    let listed: Vec<&str> = lines
+        .take_while(|l| l.starts_with(' '))
+        .map(str::trim)
+        .collect();
+    if !listed.is_empty() {
+        first = format!("{first} {}", listed.join(", "));
+    }
     // the help of the subcommand given, if one was
     let command = std::env::args()
         .skip(1)
@@ -219,9 +251,20 @@ fn main() -> ExitCode {
             modes,
             contacts,
             scaling,
-        } => match scaling {
-            Some(dir) => bench::scaling(&dir, steps.min(20_000)),
-            None => bench::main(steps, repeat, modes, contacts),
+            against_c,
+            reps,
+            only,
+            write,
+        } => match (scaling, against_c) {
+            (_, Some(dir)) => against_c::main(&against_c::Options {
+                dir,
+                reps,
+                only,
+                steps,
+                write,
+            }),
+            (Some(dir), None) => bench::scaling(&dir, steps.unwrap_or(20_000).min(20_000)),
+            (None, None) => bench::main(steps.unwrap_or(200_000), repeat, modes, contacts),
         },
     };
     match outcome {
