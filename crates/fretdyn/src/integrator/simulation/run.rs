@@ -96,8 +96,9 @@ pub fn run(
     settings: &RunSettings,
     mut observer: impl FnMut(Progress) -> ControlFlow<()>,
 ) -> Result<RunResults> {
-    let start = Instant::now();
     let mut sim = Simulation::new(model, settings)?;
+    // the time loop only, as a streamed run measures it
+    let start = Instant::now();
     let total = settings.steps;
     let mut termination = Termination::Completed;
     while sim.steps_done() < total {
