@@ -190,6 +190,22 @@ struct ImpactTracker {
 }
 
 impl ImpactTracker {
+    /// Whether [`Self::step`] has anything to do beyond remembering the penetration: the
+    /// contact is closed, or an impact is in progress (an open contact with none only moves
+    /// [`Self::idle`]'s two values along).
+    #[inline]
+    fn busy(&self, v: &StepValues) -> bool {
+        v.closed || self.active
+    }
+
+    /// [`Self::step`] of an open contact with no impact in progress: it neither starts nor
+    /// ends one, and only its penetration and time are kept for the next crossing.
+    #[inline]
+    fn idle(&mut self, v: &StepValues) {
+        self.previous_penetration = v.penetration;
+        self.previous_t = v.t;
+    }
+
     /// Zero crossing of the penetration between the previous step and this one.
     fn crossing(&self, v: &StepValues) -> f64 {
         let (d0, d1) = (self.previous_penetration, v.penetration);
@@ -280,10 +296,25 @@ pub const PEAK_BINS_PER_DECADE: usize = 10;
 const PEAK_MIN_DECADE: i32 = -6;
 const PEAK_DECADES: usize = 15;
 
-/// Running sums of one contact over a window or a block.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+/// `min(m, x)` for a running minimum `m` that is never NaN: `x` when `x < m`, else `m` (a
+/// NaN `x` is skipped). One comparison; `f64::min` would also test `m` for NaN, and gives the
+/// same value (on x86-64, bit for bit: `minsd` keeps `m` on a tie of zeros too).
+#[inline(always)]
+fn smaller(m: f64, x: f64) -> f64 {
+    if x < m { x } else { m }
+}
+
+/// `max(m, x)` for a running maximum `m` that is never NaN, as [`smaller`].
+#[inline(always)]
+fn larger(m: f64, x: f64) -> f64 {
+    if x > m { x } else { m }
+}
+
+/// Running sums of one contact over a window or a block. The number of steps is the same for
+/// every contact and is kept once, by [`ContactStatisticsState`]; the extrema start at ∓∞
+/// (no value yet) and are reported as 0 when there was no step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ContactAccumulator {
-    steps: u64,
     contact_steps: u64,
     stick_steps: u64,
     slip_steps: u64,
@@ -301,23 +332,57 @@ pub struct ContactAccumulator {
     tangential_max: f64,
     wear_work: f64,
     normal_wear_work: f64,
-    penetration_max: Option<f64>,
+    penetration_max: f64,
     radial_sum: f64,
     radial_sq_sum: f64,
-    radial_min: Option<f64>,
-    radial_max: Option<f64>,
+    radial_min: f64,
+    radial_max: f64,
     /// Σ cos θ, Σ sin θ over the contact steps (circular mean of the contact angle).
     angle_cos: f64,
     angle_sin: f64,
     peak_histogram: Vec<u64>,
 }
 
+impl Default for ContactAccumulator {
+    fn default() -> Self {
+        Self::with_histogram(vec![0; PEAK_DECADES * PEAK_BINS_PER_DECADE])
+    }
+}
+
 impl ContactAccumulator {
     /// Empty sums, with the histogram's room.
     pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Empty sums with `peak_histogram` (all zero) as the histogram.
+    fn with_histogram(peak_histogram: Vec<u64>) -> Self {
         Self {
-            peak_histogram: vec![0; PEAK_DECADES * PEAK_BINS_PER_DECADE],
-            ..Self::default()
+            contact_steps: 0,
+            stick_steps: 0,
+            slip_steps: 0,
+            impacts: 0,
+            finished_impacts: 0,
+            rebounds: 0,
+            duration_sum: 0.0,
+            duration_min: None,
+            duration_max: 0.0,
+            normal_sum: 0.0,
+            normal_sq_sum: 0.0,
+            normal_max: 0.0,
+            tangential_sum: 0.0,
+            tangential_sq_sum: 0.0,
+            tangential_max: 0.0,
+            wear_work: 0.0,
+            normal_wear_work: 0.0,
+            penetration_max: f64::NEG_INFINITY,
+            radial_sum: 0.0,
+            radial_sq_sum: 0.0,
+            radial_min: f64::INFINITY,
+            radial_max: f64::NEG_INFINITY,
+            angle_cos: 0.0,
+            angle_sin: 0.0,
+            peak_histogram,
         }
     }
 
@@ -325,39 +390,43 @@ impl ContactAccumulator {
     fn reset(&mut self) {
         let mut histogram = std::mem::take(&mut self.peak_histogram);
         histogram.iter_mut().for_each(|c| *c = 0);
-        *self = Self {
-            peak_histogram: histogram,
-            ..Self::default()
-        };
+        *self = Self::with_histogram(histogram);
     }
 
+    /// Adds one step (the caller counts it). An open contact's step only moves the offset's
+    /// sums and extrema and the largest penetration; the values are finite (checked by the
+    /// step), so that the extrema, started at `±∞`, take the first value exactly.
+    #[inline]
     fn add_step(&mut self, v: &StepValues, dt: f64) {
-        self.steps += 1;
-        let min = |m: &mut Option<f64>, x: f64| *m = Some(m.map_or(x, |m| m.min(x)));
-        let max = |m: &mut Option<f64>, x: f64| *m = Some(m.map_or(x, |m| m.max(x)));
         self.radial_sum += v.radial;
         self.radial_sq_sum += v.radial * v.radial;
-        min(&mut self.radial_min, v.radial);
-        max(&mut self.radial_max, v.radial);
-        max(&mut self.penetration_max, v.penetration);
+        self.radial_min = smaller(self.radial_min, v.radial);
+        self.radial_max = larger(self.radial_max, v.radial);
+        self.penetration_max = larger(self.penetration_max, v.penetration);
         if v.closed {
-            self.contact_steps += 1;
-            if v.stick {
-                self.stick_steps += 1;
-            } else {
-                self.slip_steps += 1;
-            }
-            self.normal_sum += v.normal;
-            self.normal_sq_sum += v.normal * v.normal;
-            self.normal_max = self.normal_max.max(v.normal);
-            self.tangential_sum += v.tangential;
-            self.tangential_sq_sum += v.tangential * v.tangential;
-            self.tangential_max = self.tangential_max.max(v.tangential);
-            self.wear_work += v.friction_power * dt;
-            self.normal_wear_work += v.normal * v.slip_speed * dt;
-            self.angle_cos += v.direction[0];
-            self.angle_sin += v.direction[1];
+            self.add_closed_step(v, dt);
         }
+    }
+
+    /// The sums of a closed step.
+    #[inline]
+    fn add_closed_step(&mut self, v: &StepValues, dt: f64) {
+        self.contact_steps += 1;
+        if v.stick {
+            self.stick_steps += 1;
+        } else {
+            self.slip_steps += 1;
+        }
+        self.normal_sum += v.normal;
+        self.normal_sq_sum += v.normal * v.normal;
+        self.normal_max = self.normal_max.max(v.normal);
+        self.tangential_sum += v.tangential;
+        self.tangential_sq_sum += v.tangential * v.tangential;
+        self.tangential_max = self.tangential_max.max(v.tangential);
+        self.wear_work += v.friction_power * dt;
+        self.normal_wear_work += v.normal * v.slip_speed * dt;
+        self.angle_cos += v.direction[0];
+        self.angle_sin += v.direction[1];
     }
 
     fn add_impact(&mut self, imp: &Impact) {
@@ -379,11 +448,18 @@ impl ContactAccumulator {
         self.peak_histogram[bin] += 1;
     }
 
-    /// Statistics over the steps added, each of duration `dt`.
-    pub fn finish(&self, name: &str, dt: f64, wear_coefficient: f64) -> ContactStatistics {
-        let n = self.steps.max(1) as f64;
+    /// Statistics over the `steps` steps added, each of duration `dt`.
+    pub fn finish(
+        &self,
+        steps: u64,
+        name: &str,
+        dt: f64,
+        wear_coefficient: f64,
+    ) -> ContactStatistics {
+        let n = steps.max(1) as f64;
         let nc = self.contact_steps.max(1) as f64;
-        let duration = self.steps as f64 * dt;
+        let duration = steps as f64 * dt;
+        let extremum = |x: f64| if steps > 0 { x } else { 0.0 };
         let rate = |x: f64| if duration > 0.0 { x / duration } else { 0.0 };
         let ni = self.finished_impacts.max(1) as f64;
         let (angle_mean, angle_spread) = if self.contact_steps > 0 {
@@ -442,11 +518,11 @@ impl ContactAccumulator {
             wear_work_rate: rate(self.wear_work),
             normal_wear_work_rate: rate(self.normal_wear_work),
             wear_volume: wear_coefficient * self.wear_work,
-            penetration_max: self.penetration_max.unwrap_or(0.0),
+            penetration_max: extremum(self.penetration_max),
             displacement_mean: self.radial_sum / n,
             displacement_rms: (self.radial_sq_sum / n).sqrt(),
-            displacement_min: self.radial_min.unwrap_or(0.0),
-            displacement_max: self.radial_max.unwrap_or(0.0),
+            displacement_min: extremum(self.radial_min),
+            displacement_max: extremum(self.radial_max),
             contact_angle_mean_deg: angle_mean,
             contact_angle_spread_deg: angle_spread,
             peak_force_histogram: histogram,
@@ -543,11 +619,21 @@ pub struct BlockStatistics {
 /// impact trackers; finished impacts and blocks wait in [`Self::impacts`] and
 /// [`Self::blocks`] until drained by the caller (a streaming run drains them at each flush,
 /// so that memory stays flat).
+///
+/// Cost per step: an open contact with no impact in progress adds its offset and penetration
+/// to the window (and to the block, when there are blocks: without, there are no block
+/// accumulators at all) and keeps its penetration for the next crossing; the steps are
+/// counted once for all contacts.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ContactStatisticsState {
     settings_block: Option<f64>,
     window: Vec<ContactAccumulator>,
+    /// Steps in the window so far (the same for every contact).
+    window_steps: u64,
+    /// One per contact with blocks, none without.
     block: Vec<ContactAccumulator>,
+    /// Steps in the current block so far.
+    block_steps: u64,
     block_index: u64,
     trackers: Vec<ImpactTracker>,
     /// Finished impacts started in the window, not yet drained.
@@ -559,26 +645,26 @@ pub struct ContactStatisticsState {
 impl ContactStatisticsState {
     /// Empty statistics for `contacts` contacts.
     pub fn new(contacts: usize, settings: &StatisticsSettings) -> Self {
+        let blocks = settings.block.is_some();
         Self {
             settings_block: settings.block,
             window: vec![ContactAccumulator::new(); contacts],
-            block: vec![ContactAccumulator::new(); contacts],
+            window_steps: 0,
+            block: vec![ContactAccumulator::new(); if blocks { contacts } else { 0 }],
+            block_steps: 0,
             block_index: 0,
             trackers: vec![ImpactTracker::default(); contacts],
             // room for the impacts that end between two drains: the step loop does not
             // allocate unless more wait (then the room grows once and is kept)
             impacts: Vec::with_capacity(IMPACT_ROOM_PER_CONTACT * contacts),
-            blocks: Vec::with_capacity(if settings.block.is_some() {
-                4 * contacts
-            } else {
-                0
-            }),
+            blocks: Vec::with_capacity(if blocks { 4 * contacts } else { 0 }),
         }
     }
 
     /// True when it follows `n` contacts.
     pub fn has_contacts(&self, n: usize) -> bool {
-        self.window.len() == n && self.block.len() == n && self.trackers.len() == n
+        let blocks = if self.settings_block.is_some() { n } else { 0 };
+        self.window.len() == n && self.block.len() == blocks && self.trackers.len() == n
     }
 
     /// Starts the trackers at t = 0 with the contacts' penetrations.
@@ -602,31 +688,45 @@ impl ContactStatisticsState {
     ) {
         let in_window = settings.step_in_window(t, dt);
         if in_window {
+            self.window_steps += 1;
             if let Some(b) = settings.block {
                 // the block of this step; close the previous ones
                 let index = settings.block_of(t, dt, b);
                 while index > self.block_index {
                     self.close_block(settings, names, dt);
                 }
+                self.block_steps += 1;
             }
         }
-        for (k, v) in values.enumerate() {
-            let (started, finished) =
-                self.trackers[k].step(k, &v, settings.rest_duration, in_window);
+        let rest = settings.rest_duration;
+        let Self {
+            window,
+            block,
+            trackers,
+            impacts,
+            ..
+        } = self;
+        for (k, ((v, tracker), window)) in values.zip(trackers.iter_mut()).zip(window).enumerate() {
+            // the sums and the impacts' counts are apart: their order does not matter
             if in_window {
-                self.window[k].add_step(&v, dt);
-                self.block[k].add_step(&v, dt);
-                if started {
-                    self.window[k].impacts += 1;
-                    self.block[k].impacts += 1;
+                window.add_step(&v, dt);
+                if let Some(block) = block.get_mut(k) {
+                    block.add_step(&v, dt);
                 }
             }
-            if let Some(imp) = finished {
-                if self.trackers[k].in_window {
-                    self.window[k].add_impact(&imp);
-                    self.block[k].add_impact(&imp);
-                    self.impacts.push(imp);
-                }
+            if tracker.busy(&v) {
+                impact_step(
+                    k,
+                    v,
+                    rest,
+                    in_window,
+                    tracker,
+                    window,
+                    block.get_mut(k),
+                    impacts,
+                );
+            } else {
+                tracker.idle(&v);
             }
         }
     }
@@ -635,7 +735,8 @@ impl ContactStatisticsState {
         let b = settings.block.unwrap_or(f64::INFINITY);
         let t0 = settings.t_start + self.block_index as f64 * b;
         for (k, acc) in self.block.iter_mut().enumerate() {
-            let mut statistics = acc.finish(&names[k], dt, settings.wear_coefficient);
+            let mut statistics =
+                acc.finish(self.block_steps, &names[k], dt, settings.wear_coefficient);
             statistics.peak_force_histogram.clear();
             self.blocks.push(BlockStatistics {
                 block: self.block_index,
@@ -645,6 +746,7 @@ impl ContactStatisticsState {
             });
             acc.reset();
         }
+        self.block_steps = 0;
         self.block_index += 1;
     }
 
@@ -668,18 +770,20 @@ impl ContactStatisticsState {
                 tr.active = false;
                 if tr.in_window {
                     self.window[k].add_impact(&imp);
-                    self.block[k].add_impact(&imp);
+                    if let Some(block) = self.block.get_mut(k) {
+                        block.add_impact(&imp);
+                    }
                     self.impacts.push(imp);
                 }
             }
         }
-        if settings.block.is_some() && self.block.iter().any(|a| a.steps > 0) {
+        if settings.block.is_some() && self.block_steps > 0 {
             let b = settings.block.unwrap_or(f64::INFINITY);
             let t0 = settings.t_start + self.block_index as f64 * b;
-            let steps = self.block[0].steps;
+            let steps = self.block_steps;
             self.close_block(settings, names, dt);
             // a partial block ends with its last step
-            let n = names.len();
+            let n = self.block.len();
             let len = self.blocks.len();
             for row in &mut self.blocks[len - n..] {
                 row.t_end = t0 + steps as f64 * dt;
@@ -688,7 +792,242 @@ impl ContactStatisticsState {
         self.window
             .iter()
             .zip(names)
-            .map(|(a, name)| a.finish(name, dt, settings.wear_coefficient))
+            .map(|(a, name)| a.finish(self.window_steps, name, dt, settings.wear_coefficient))
             .collect()
+    }
+}
+
+/// The step of contact `k` when it is closed or in an impact ([`ImpactTracker::busy`]): the
+/// tracker's step, then an impact that starts in a step of the window counts in the window
+/// (and in the block), and one that ends, having started in the window, is added to them
+/// and to the table.
+#[allow(clippy::too_many_arguments)]
+fn impact_step(
+    k: usize,
+    v: StepValues,
+    rest: f64,
+    in_window: bool,
+    tracker: &mut ImpactTracker,
+    window: &mut ContactAccumulator,
+    mut block: Option<&mut ContactAccumulator>,
+    impacts: &mut Vec<Impact>,
+) {
+    let (started, finished) = tracker.step(k, &v, rest, in_window);
+    if in_window && started {
+        window.impacts += 1;
+        if let Some(block) = block.as_deref_mut() {
+            block.impacts += 1;
+        }
+    }
+    if let Some(imp) = finished {
+        if tracker.in_window {
+            window.add_impact(&imp);
+            if let Some(block) = block {
+                block.add_impact(&imp);
+            }
+            impacts.push(imp);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DT: f64 = 1e-3;
+    const STEPS: u64 = 1000;
+
+    /// Values of contact `k` at the end of step `n`: a penetration that oscillates through
+    /// zero at a few frequencies (impacts, rebounds and long openings), forces of a closed
+    /// contact only, an offset of both signs, and the first contact open all along.
+    fn values(k: usize, n: u64) -> StepValues {
+        let t = n as f64 * DT;
+        let phase = k as f64;
+        let penetration = if k == 0 {
+            -1e-3 - 1e-4 * (7.0 * t).sin()
+        } else {
+            1e-4 * ((40.0 + 13.0 * phase) * t + phase).sin() - 4e-5 * (170.0 * t).cos()
+        };
+        let closed = penetration > 0.0;
+        let normal = if closed { 1e6 * penetration } else { 0.0 };
+        let angle = 3.0 * t + phase;
+        StepValues {
+            t,
+            closed,
+            stick: closed && (90.0 * t).sin() > 0.0,
+            normal,
+            tangential: 0.3 * normal,
+            slip_speed: if closed { 1e-3 * (1.0 + t) } else { 0.0 },
+            friction_power: if closed { 0.3 * normal * 1e-3 } else { 0.0 },
+            penetration,
+            radial: 2e-4 * (11.0 * t + phase).sin() + penetration,
+            direction: [angle.cos(), angle.sin()],
+        }
+    }
+
+    const CONTACTS: usize = 3;
+
+    fn names() -> Vec<String> {
+        (0..CONTACTS).map(|k| format!("c{k}")).collect()
+    }
+
+    /// Steps `from + 1 ..= to` of the synthetic run.
+    fn advance(
+        state: &mut ContactStatisticsState,
+        settings: &StatisticsSettings,
+        from: u64,
+        to: u64,
+    ) {
+        let names = names();
+        for n in from + 1..=to {
+            let t = n as f64 * DT;
+            state.step(settings, &names, t, DT, (0..CONTACTS).map(|k| values(k, n)));
+        }
+    }
+
+    fn started(settings: &StatisticsSettings) -> ContactStatisticsState {
+        let mut state = ContactStatisticsState::new(CONTACTS, settings);
+        state.start((0..CONTACTS).map(|k| {
+            let v = values(k, 0);
+            (v.penetration, v.closed)
+        }));
+        state
+    }
+
+    /// Window statistics, impacts and blocks of the whole synthetic run.
+    fn run(
+        settings: &StatisticsSettings,
+    ) -> (Vec<ContactStatistics>, Vec<Impact>, Vec<BlockStatistics>) {
+        let mut state = started(settings);
+        advance(&mut state, settings, 0, STEPS);
+        let window = state.finish(settings, &names(), DT);
+        (window, state.impacts, state.blocks)
+    }
+
+    fn settings(block: Option<f64>) -> StatisticsSettings {
+        StatisticsSettings {
+            t_start: 0.1,
+            t_end: 0.85,
+            block,
+            rest_duration: 2e-3,
+            wear_coefficient: 1e-15,
+        }
+    }
+
+    /// Blocks are a cut of the window: asking for them changes neither the window's
+    /// statistics nor the impacts, and without them nothing is kept for blocks.
+    #[test]
+    fn blocks_do_not_change_the_window() {
+        let (window, impacts, blocks) = run(&settings(None));
+        let (window_b, impacts_b, blocks_b) = run(&settings(Some(0.07)));
+        assert_eq!(window, window_b);
+        assert_eq!(impacts, impacts_b);
+        assert!(blocks.is_empty());
+        assert!(!blocks_b.is_empty());
+        assert!(window.iter().skip(1).all(|c| c.impacts > 0));
+        let state = ContactStatisticsState::new(CONTACTS, &settings(None));
+        assert!(state.block.is_empty() && state.has_contacts(CONTACTS));
+        let state = ContactStatisticsState::new(CONTACTS, &settings(Some(0.07)));
+        assert_eq!(state.block.len(), CONTACTS);
+        assert!(state.has_contacts(CONTACTS) && !state.has_contacts(CONTACTS + 1));
+    }
+
+    /// The blocks add up to the window: their steps, their impacts started; their extrema
+    /// are the window's.
+    #[test]
+    fn blocks_add_up_to_the_window() {
+        let (window, _, blocks) = run(&settings(Some(0.07)));
+        for (k, w) in window.iter().enumerate() {
+            let rows: Vec<_> = blocks
+                .iter()
+                .filter(|b| b.statistics.name == w.name)
+                .map(|b| &b.statistics)
+                .collect();
+            assert_eq!(rows.len(), 11, "contact {k}: 0.75 s in blocks of 0.07 s");
+            let steps = |d: f64| (d / DT).round() as u64;
+            assert_eq!(
+                rows.iter().map(|s| steps(s.duration)).sum::<u64>(),
+                steps(w.duration)
+            );
+            assert_eq!(rows.iter().map(|s| s.impacts).sum::<u64>(), w.impacts);
+            let fold = |f: fn(&ContactStatistics) -> f64, max: bool| {
+                rows.iter().map(|s| f(s)).fold(
+                    if max {
+                        f64::NEG_INFINITY
+                    } else {
+                        f64::INFINITY
+                    },
+                    if max { f64::max } else { f64::min },
+                )
+            };
+            assert_eq!(fold(|s| s.displacement_max, true), w.displacement_max);
+            assert_eq!(fold(|s| s.displacement_min, false), w.displacement_min);
+            assert_eq!(fold(|s| s.penetration_max, true), w.penetration_max);
+            assert_eq!(fold(|s| s.normal_force_max, true), w.normal_force_max);
+        }
+    }
+
+    /// The window's extrema are those of the values of its steps (by the midpoint rule), and
+    /// 0 for a window with no step.
+    #[test]
+    fn extrema_are_those_of_the_window_steps() {
+        let s = settings(None);
+        let (window, _, _) = run(&s);
+        for (k, w) in window.iter().enumerate() {
+            let steps: Vec<_> = (1..=STEPS)
+                .filter(|&n| s.step_in_window(n as f64 * DT, DT))
+                .map(|n| values(k, n))
+                .collect();
+            assert_eq!(steps.len(), 750);
+            assert_eq!(w.duration, steps.len() as f64 * DT);
+            let min = steps.iter().map(|v| v.radial).reduce(f64::min).unwrap();
+            let max = steps.iter().map(|v| v.radial).reduce(f64::max).unwrap();
+            let pen = steps
+                .iter()
+                .map(|v| v.penetration)
+                .reduce(f64::max)
+                .unwrap();
+            assert_eq!((w.displacement_min, w.displacement_max), (min, max));
+            assert_eq!(w.penetration_max, pen);
+            assert!(k > 0 || pen < 0.0, "the first contact stays open");
+        }
+        let late = StatisticsSettings {
+            t_start: 2.0 * STEPS as f64 * DT,
+            ..settings(Some(0.07))
+        };
+        let (window, impacts, blocks) = run(&late);
+        assert!(impacts.is_empty() && blocks.is_empty());
+        for w in &window {
+            assert_eq!((w.duration, w.impacts), (0.0, 0));
+            assert_eq!(
+                (w.displacement_min, w.displacement_max, w.penetration_max),
+                (0.0, 0.0, 0.0)
+            );
+        }
+    }
+
+    /// A state saved (as a checkpoint saves it) and restored mid-run, even mid-block, ends
+    /// with the results of the uninterrupted run.
+    #[test]
+    fn a_restored_state_gives_the_uninterrupted_results() {
+        for block in [None, Some(0.07)] {
+            let s = settings(block);
+            let (window, impacts, blocks) = run(&s);
+            let mut state = started(&s);
+            let mut drained = (Vec::new(), Vec::new());
+            for (from, to) in [(0, 137), (137, 512), (512, STEPS)] {
+                advance(&mut state, &s, from, to);
+                drained.0.append(&mut state.impacts);
+                drained.1.append(&mut state.blocks);
+                let mut bytes = Vec::new();
+                ciborium::into_writer(&state, &mut bytes).unwrap();
+                state = ciborium::from_reader(bytes.as_slice()).unwrap();
+            }
+            let window_r = state.finish(&s, &names(), DT);
+            drained.0.append(&mut state.impacts);
+            drained.1.append(&mut state.blocks);
+            assert_eq!(window_r, window);
+            assert_eq!(drained, (impacts, blocks));
+        }
     }
 }

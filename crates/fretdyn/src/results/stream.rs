@@ -102,8 +102,9 @@ pub const RESULTS_FILE: &str = "results.npz";
 /// code that started it.
 pub const CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNC";
 
-/// Format version of `checkpoint.bin` (1 was bincode, without a header).
-pub const CHECKPOINT_FORMAT: u32 = 2;
+/// Format version of `checkpoint.bin` (1 was bincode, without a header; 2 counted the
+/// statistics' steps per contact and accumulated blocks when there were none).
+pub const CHECKPOINT_FORMAT: u32 = 3;
 
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {
