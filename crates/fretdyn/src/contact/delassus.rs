@@ -48,11 +48,15 @@ pub struct TangentialProblem {
     b: Vec<f64>,
     /// `H_kk` of each slot, prepared for its local solve.
     diagonal: Vec<DiagonalBlock>,
+    /// `H_cc` of each fixed contact, prepared once ([`Self::fix_rows`]).
+    diagonal_fixed: Vec<DiagonalBlock>,
     stride: usize,
     /// The closed contacts of the last singularity test whose `H` was made of fixed rows
     /// only, and its answer ([`Self::is_singular`]).
     singular_for: Vec<usize>,
     singular: Option<bool>,
+    /// Whether the local solves are exact ([`Self::set_exact_local_solve`]).
+    exact: bool,
 }
 
 impl TangentialProblem {
@@ -70,9 +74,11 @@ impl TangentialProblem {
             h: vec![0.0; rows * rows],
             b: vec![0.0; rows],
             diagonal: vec![DiagonalBlock::default(); contacts],
+            diagonal_fixed: vec![DiagonalBlock::default(); contacts],
             stride: rows,
             singular_for: Vec::with_capacity(contacts),
             singular: None,
+            exact: true,
         }
     }
 
@@ -107,6 +113,14 @@ impl TangentialProblem {
                 }
             }
         }
+        let (r, st) = (2 * contact, self.stride);
+        let h = Matrix2::new(
+            self.h_fixed[r * st + r],
+            self.h_fixed[r * st + r + 1],
+            self.h_fixed[(r + 1) * st + r],
+            self.h_fixed[(r + 1) * st + r + 1],
+        );
+        self.diagonal_fixed[contact] = DiagonalBlock::new(h, true);
     }
 
     fn compute_rows(
@@ -125,6 +139,12 @@ impl TangentialProblem {
             }
             apply_a_inv(l, &mut self.al[r * p..(r + 1) * p]);
         }
+    }
+
+    /// Whether the local solves of the diagonal blocks are exact (the default: their
+    /// eigen-decomposition is then prepared with them) or the radial projection.
+    pub fn set_exact_local_solve(&mut self, exact: bool) {
+        self.exact = exact;
     }
 
     /// Row of `L` (in the per-contact layout) of slot row `r`.
@@ -196,6 +216,7 @@ impl TangentialProblem {
     ) {
         let p = self.p;
         let n = 2 * self.slots.len();
+        let inverse_theta_dt = 1.0 / theta_dt;
         let mut vimp = Vector2::zeros();
         for r in 0..n {
             let lr_index = self.contact_row(r);
@@ -215,10 +236,15 @@ impl TangentialProblem {
                 vimp = v_imp(&self.slots[r / 2]);
             }
             let (acceleration, velocity) = crate::structure::modal::dot2(lr, qdd_free, qd_star);
-            self.b[r] = acceleration + (velocity - vimp[r % 2]) / theta_dt;
+            self.b[r] = acceleration + (velocity - vimp[r % 2]) * inverse_theta_dt;
         }
         for k in 0..self.slots.len() {
-            self.diagonal[k] = DiagonalBlock::new(self.block(k, k));
+            let c = self.slots[k].contact;
+            self.diagonal[k] = if self.fixed[c] {
+                self.diagonal_fixed[c]
+            } else {
+                DiagonalBlock::new(self.block(k, k), self.exact)
+            };
         }
     }
 
@@ -289,16 +315,14 @@ impl TangentialProblem {
         let mut l2 = 0.0;
         let mut s_max = 0.0f64;
         for (k, slot) in self.slots.iter().enumerate() {
-            let h = self.block(k, k);
-            let trace = h[(0, 0)] + h[(1, 1)];
-            let rho = if trace > 0.0 { 2.0 / trace } else { 0.0 };
+            let rho = self.diagonal[k].rho();
             let s = match slide[k] {
                 Slide::Stick => slot.s_static,
                 Slide::Slip => slot.s_dynamic,
             };
             let z = lambda[k] + self.residual_velocity(k, lambda) * rho;
-            let n = z.norm();
-            let projected = if n > s { z * (s / n) } else { z };
+            let n2 = z.norm_squared();
+            let projected = if n2 > s * s { z * (s / n2.sqrt()) } else { z };
             r2 += (lambda[k] - projected).norm_squared();
             l2 += lambda[k].norm_squared();
             s_max = s_max.max(slot.s_static);

@@ -68,29 +68,36 @@ pub struct DiagonalBlock {
     /// `H_ii`.
     pub h: Matrix2<f64>,
     inverse: Matrix2<f64>,
-    rotation: Matrix2<f64>,
-    eigenvalues: [f64; 2],
+    /// The eigen-decomposition `H = Q diag(h) Qᵀ`, for the exact slip solution (not formed
+    /// for the radial projection, which does not need it).
+    eigen: Option<(Matrix2<f64>, [f64; 2])>,
     isotropic: bool,
 }
 
 impl DiagonalBlock {
-    /// The block `h` (symmetric positive semi-definite).
+    /// The block `h` (symmetric positive semi-definite); `exact` when the exact local solve
+    /// will be asked of it.
     #[inline]
-    pub fn new(h: Matrix2<f64>) -> Self {
-        let (rotation, eigenvalues) = symmetric_eigen2(&h);
+    pub fn new(h: Matrix2<f64>, exact: bool) -> Self {
         Self {
             h,
             inverse: inverse2(&h),
-            rotation,
-            eigenvalues,
+            eigen: exact.then(|| symmetric_eigen2(&h)),
             isotropic: is_isotropic(&h),
         }
+    }
+
+    /// The step `ρ = 2/tr(H_ii)` of the natural map (THEORY §4.2), 0 for a zero block.
+    #[inline]
+    pub fn rho(&self) -> f64 {
+        let trace = self.h[(0, 0)] + self.h[(1, 1)];
+        if trace > 0.0 { 2.0 / trace } else { 0.0 }
     }
 }
 
 impl Default for DiagonalBlock {
     fn default() -> Self {
-        Self::new(Matrix2::zeros())
+        Self::new(Matrix2::zeros(), false)
     }
 }
 
@@ -108,7 +115,8 @@ pub fn local_solve(
     s_dynamic: f64,
     mode: LocalSolve,
 ) -> (Vector2<f64>, Slide) {
-    local_solve_block(&DiagonalBlock::new(*h), c, s_static, s_dynamic, mode)
+    let block = DiagonalBlock::new(*h, mode == LocalSolve::Exact);
+    local_solve_block(&block, c, s_static, s_dynamic, mode)
 }
 
 /// [`local_solve`] on a block prepared once per step ([`DiagonalBlock`]).
@@ -158,9 +166,19 @@ pub fn inverse2(h: &Matrix2<f64>) -> Matrix2<f64> {
             -h[(1, 0)] * id,
             h[(0, 0)] * id,
         )
-    } else if scale > 0.0 {
+    } else {
+        pseudo_inverse2(h, scale)
+    }
+}
+
+/// The pseudo-inverse of a singular symmetric 2 × 2 matrix whose largest diagonal term is
+/// `scale` (zero for a zero matrix).
+#[cold]
+#[inline(never)]
+fn pseudo_inverse2(h: &Matrix2<f64>, scale: f64) -> Matrix2<f64> {
+    let mut out = Matrix2::zeros();
+    if scale > 0.0 {
         let eig = h.symmetric_eigen();
-        let mut out = Matrix2::zeros();
         for k in 0..2 {
             let e = eig.eigenvalues[k];
             if e.abs() > 1e-13 * scale {
@@ -168,10 +186,8 @@ pub fn inverse2(h: &Matrix2<f64>) -> Matrix2<f64> {
                 out += v * v.transpose() / e;
             }
         }
-        out
-    } else {
-        Matrix2::zeros()
     }
+    out
 }
 
 /// `H⁻¹ c` for a 2 × 2 matrix, with a pseudo-inverse fallback when `H` is singular
@@ -195,7 +211,8 @@ pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
 /// hole) costs Newton one step down (an earlier version projected radially when the start
 /// was not below the root, off by up to 1e-4 in direction).
 fn disk_boundary_solve(block: &DiagonalBlock, c: &Vector2<f64>, s: f64) -> Vector2<f64> {
-    let (h, q, eigenvalues) = (&block.h, block.rotation, block.eigenvalues);
+    let h = &block.h;
+    let (q, eigenvalues) = block.eigen.unwrap_or_else(|| symmetric_eigen2(h));
     let hs = [s * eigenvalues[0], s * eigenvalues[1]];
     let cp = q.transpose() * c;
     // u(t) in the eigenbasis; a component of c that is exactly 0 stays 0 (also at t = lower).

@@ -65,6 +65,11 @@ impl EnergyBalance {
             .scale
             .max(e.abs())
             .max(self.initial.abs() + self.external_work.abs());
+    }
+
+    /// Sets [`Self::relative_error`] from the running maxima (once, when the balance is
+    /// read: not at every step).
+    pub fn settle(&mut self) {
         self.relative_error = if self.scale > 0.0 {
             self.max_abs / self.scale
         } else {

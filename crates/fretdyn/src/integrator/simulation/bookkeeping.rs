@@ -11,8 +11,10 @@ use crate::structure::modal::recombine;
 impl Simulation<'_> {
     /// Energy `E` and the powers `[external (loads and moving obstacles), modal damping,
     /// contact damping, tangential]`.
-    pub(super) fn energy_and_powers(&self) -> (f64, [f64; 4]) {
-        let (mut e, modal_damping, external) = self.cd.energy_and_powers(&self.external);
+    /// `modal`: the structure's energy, modal damping power and external power
+    /// ([`crate::integrator::central_difference::CentralDifference::energy_and_powers`]).
+    pub(super) fn energy_and_powers(&self, modal: (f64, f64, f64)) -> (f64, [f64; 4]) {
+        let (mut e, modal_damping, external) = modal;
         let mut contact_damping = 0.0;
         let mut tangential = 0.0;
         let mut obstacle = 0.0;
@@ -88,7 +90,11 @@ impl Simulation<'_> {
             impacts: Vec::new(),
             blocks: Vec::new(),
             solver: self.solver_stats.clone(),
-            energy: self.energy.clone(),
+            energy: {
+                let mut energy = self.energy.clone();
+                energy.settle();
+                energy
+            },
             steps: self.step,
             dt: self.settings.dt,
             stable_dt: self.stable_dt,
@@ -107,6 +113,7 @@ impl Simulation<'_> {
         let contacts = self
             .statistics
             .finish(&self.settings.statistics, &self.names, dt);
+        self.energy.settle();
         RunResults {
             contacts,
             impacts: std::mem::take(&mut self.statistics.impacts),
@@ -146,18 +153,22 @@ pub(super) fn step_values(
     } else {
         (c.local(&s.x, t).x, [1.0, 0.0])
     };
-    let (slip_speed, friction_power) = if s.closed {
+    let (slip_speed, friction_power, tangential) = if s.closed {
         let vt = s.tangential_velocity();
-        (vt.norm(), s.tangential_force.dot(&vt).abs())
+        (
+            vt.norm(),
+            s.tangential_force.dot(&vt).abs(),
+            s.tangential_force.norm(),
+        )
     } else {
-        (0.0, 0.0)
+        (0.0, 0.0, 0.0)
     };
     StepValues {
         t,
         closed: s.closed,
         stick: s.slide == Slide::Stick,
         normal: s.normal_force,
-        tangential: s.tangential_force.norm(),
+        tangential,
         slip_speed,
         friction_power,
         penetration: s.frame.penetration,

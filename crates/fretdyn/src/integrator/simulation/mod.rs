@@ -517,7 +517,7 @@ impl<'m> Simulation<'m> {
                 };
             }
         }
-        let (e, powers) = self.energy_and_powers();
+        let (e, powers) = self.energy_and_powers(self.cd.energy_and_powers(&self.external));
         self.energy = EnergyBalance::start(e, powers);
         self.statistics.start(
             self.contacts
@@ -552,7 +552,7 @@ impl<'m> Simulation<'m> {
         self.contact_forces();
         self.cd.free_acceleration(&self.force);
         self.lagrange();
-        self.cd.correct();
+        let modal = self.cd.correct(&self.external);
         self.full_step_velocities(false);
 
         let dt = self.settings.dt;
@@ -566,7 +566,7 @@ impl<'m> Simulation<'m> {
         if let Some(k) = self.contacts.iter().position(|c| !c.accumulable(bound)) {
             return Err(diverged(Some(k)));
         }
-        let (e, powers) = self.energy_and_powers();
+        let (e, powers) = self.energy_and_powers(modal);
         let magnitude = e.abs() + powers.iter().map(|p| p.abs()).sum::<f64>();
         if magnitude > bound || magnitude.is_nan() {
             return Err(diverged(None));

@@ -9,7 +9,7 @@ use crate::contact::delassus::{Slot, TangentialProblem};
 use crate::contact::friction::Slide;
 use crate::contact::tangential::active_set::{ActiveSet, History};
 use crate::contact::tangential::penalty::PenaltyContact;
-use crate::contact::tangential::{StickVelocity, gauss_seidel};
+use crate::contact::tangential::{LocalSolve, StickVelocity, gauss_seidel};
 use crate::integrator::central_difference::CentralDifference;
 use crate::model::Model;
 
@@ -120,11 +120,13 @@ impl Simulation<'_> {
                 && (!half_step || (before.closed && before.slide == Slide::Stick));
         }
         history.iter_mut().for_each(|h| h.closed = false);
+        let active_set = matches!(solver, LagrangeSolver::ActiveSet(_));
         for (k, slot) in problem.slots().iter().enumerate() {
             let state = &mut self.contacts[slot.contact];
             state.tangential_force = -lambda[k];
             state.slide = slide[k];
-            let n = lambda[k].norm();
+            // the slip direction serves the Active Set's first guess only
+            let n = if active_set { lambda[k].norm() } else { 0.0 };
             history[slot.contact] = History {
                 closed: true,
                 slide: slide[k],
@@ -174,6 +176,10 @@ impl Tangential {
     ) -> Self {
         let nc = model.contacts.len();
         let mut problem = TangentialProblem::new(model.basis.modes(), nc);
+        problem.set_exact_local_solve(match &solver {
+            LagrangeSolver::GaussSeidel(s) => s.local_solve == LocalSolve::Exact,
+            LagrangeSolver::ActiveSet(_) => true,
+        });
         for (k, c) in model.contacts.iter().enumerate() {
             if let Some(t) = c.fixed_tangents() {
                 let point = &model.basis.points[c.point];
