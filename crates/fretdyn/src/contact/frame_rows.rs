@@ -51,9 +51,13 @@ impl FrameRows {
         let mut rows = vec![0.0; 3 * p];
         // the normal row from the point's own rows (n·(R n × Θ) = 0: the surface adds nothing
         // along the normal), the tangent rows from the contact point's
-        for (d, (dir, src)) in [(normal, &point.rows), (tangents[0], &surface), (tangents[1], &surface)]
-            .iter()
-            .enumerate()
+        for (d, (dir, src)) in [
+            (normal, &point.rows),
+            (tangents[0], &surface),
+            (tangents[1], &surface),
+        ]
+        .iter()
+        .enumerate()
         {
             let out = &mut rows[d * p..(d + 1) * p];
             for (i, o) in out.iter_mut().enumerate() {
@@ -99,11 +103,7 @@ impl FrameRows {
     pub fn update(&self, s: f64, frame: &mut ContactFrame) {
         if self.two_sided {
             frame.penetration = s.abs() - self.gap;
-            frame.normal = if s >= 0.0 {
-                -self.normal
-            } else {
-                self.normal
-            };
+            frame.normal = if s >= 0.0 { -self.normal } else { self.normal };
         } else {
             frame.penetration = -s - self.gap;
         }

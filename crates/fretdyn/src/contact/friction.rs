@@ -129,13 +129,15 @@ pub fn local_solve_block(
     mode: LocalSolve,
 ) -> (Vector2<f64>, Slide) {
     let free = block.inverse * c;
-    let norm = free.norm();
-    if norm <= s_static {
+    // |free| ≤ s_static compared squared: no square root for a stick
+    let norm2 = free.norm_squared();
+    if norm2 <= s_static * s_static {
         return (free, Slide::Stick);
     }
     if s_dynamic <= 0.0 {
         return (Vector2::zeros(), Slide::Slip);
     }
+    let norm = norm2.sqrt();
     let lambda = match mode {
         LocalSolve::Radial => free * (s_dynamic / norm),
         LocalSolve::Exact if block.isotropic => free * (s_dynamic / norm),

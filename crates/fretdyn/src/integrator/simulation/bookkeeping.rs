@@ -2,10 +2,10 @@
 //! sample, the per-contact values for the statistics, and the results (THEORY §5).
 
 use super::{ContactState, RunResults, Simulation, Termination};
+use crate::contact::frame_rows::FrameRows;
 use crate::contact::friction::Slide;
 use crate::results::recorder::{ContactSample, Recorder};
 use crate::results::statistics::StepValues;
-use crate::contact::frame_rows::FrameRows;
 use crate::structure::modal::recombine;
 
 impl Simulation<'_> {
@@ -53,7 +53,12 @@ impl Simulation<'_> {
             return None;
         }
         let mut non_finite = None;
-        for (k, (s, c)) in self.contacts.iter_mut().zip(&self.model.contacts).enumerate() {
+        for (k, (s, c)) in self
+            .contacts
+            .iter_mut()
+            .zip(&self.model.contacts)
+            .enumerate()
+        {
             if self.frame_rows[k].is_some() {
                 // a plane's or bars' 3-D position is formed for the samples only
                 let pt = &self.model.basis.points[c.point];

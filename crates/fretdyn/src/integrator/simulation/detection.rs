@@ -179,8 +179,7 @@ impl ContactState {
                 let f = &self.frame;
                 self.v_normal = if damped { f.normal.dot(&v) } else { 0.0 };
                 if tangential {
-                    self.v_tangential =
-                        Vector2::new(f.tangents[0].dot(&v), f.tangents[1].dot(&v));
+                    self.v_tangential = Vector2::new(f.tangents[0].dot(&v), f.tangents[1].dot(&v));
                 }
             }
         }

@@ -189,6 +189,8 @@ pub struct Simulation<'m> {
     energy: EnergyBalance,
     recorder: Recorder,
     step: u64,
+    /// The step of the next output sample (a multiple of `output_every`).
+    next_sample: u64,
     /// [`Self::accumulation_bound`] of the settings.
     accumulation_bound: f64,
 }
@@ -262,6 +264,8 @@ impl<'m> Simulation<'m> {
             return Err(mismatch("number of contacts"));
         }
         sim.step = snapshot.step;
+        sim.next_sample =
+            (snapshot.step / settings.output_every + 1).saturating_mul(settings.output_every);
         sim.cd.q.copy_from_slice(&snapshot.q);
         sim.cd.qd.copy_from_slice(&snapshot.qd);
         sim.cd.qdd.copy_from_slice(&snapshot.qdd);
@@ -496,6 +500,7 @@ impl<'m> Simulation<'m> {
             energy: EnergyBalance::default(),
             recorder: Recorder::new(samples, p, nc),
             step: 0,
+            next_sample: settings.output_every,
             accumulation_bound: Self::accumulation_bound(settings),
         })
     }
@@ -571,7 +576,8 @@ impl<'m> Simulation<'m> {
         if magnitude > bound || magnitude.is_nan() {
             return Err(diverged(None));
         }
-        if self.step % self.settings.output_every == 0 {
+        let sample = self.step == self.next_sample;
+        if sample {
             self.full_step_velocities(true);
             if let Some(k) = self.sample() {
                 self.recorder.discard_last();
@@ -588,6 +594,9 @@ impl<'m> Simulation<'m> {
             .map(|((s, c), rows)| step_values(s, c, rows.as_ref(), t));
         self.statistics
             .step(&self.settings.statistics, &self.names, t, dt, values);
+        if sample {
+            self.next_sample = self.next_sample.saturating_add(self.settings.output_every);
+        }
         Ok(())
     }
 
