@@ -14,6 +14,8 @@
 //! The rows of a contact whose tangent basis never changes (a fixed plane) are computed once,
 //! and so are the blocks of `H` between two such contacts: a step then only gathers them.
 
+use std::cell::Cell;
+
 use nalgebra::{Matrix2, Vector2, Vector3};
 
 use crate::contact::friction::{DiagonalBlock, Slide};
@@ -50,6 +52,9 @@ pub struct TangentialProblem {
     diagonal: Vec<DiagonalBlock>,
     /// `H_cc` of each fixed contact, prepared once ([`Self::fix_rows`]).
     diagonal_fixed: Vec<DiagonalBlock>,
+    /// Per slot, the Newton start of its exact slip solve within the step
+    /// ([`crate::contact::friction::local_solve_block`]); reset by [`Self::assemble`].
+    newton: Vec<Cell<f64>>,
     stride: usize,
     /// The closed contacts of the last singularity test whose `H` was made of fixed rows
     /// only, and its answer ([`Self::is_singular`]).
@@ -75,6 +80,7 @@ impl TangentialProblem {
             b: vec![0.0; rows],
             diagonal: vec![DiagonalBlock::default(); contacts],
             diagonal_fixed: vec![DiagonalBlock::default(); contacts],
+            newton: vec![Cell::new(f64::NAN); contacts],
             stride: rows,
             singular_for: Vec::with_capacity(contacts),
             singular: None,
@@ -239,6 +245,7 @@ impl TangentialProblem {
             self.b[r] = acceleration + (velocity - vimp[r % 2]) * inverse_theta_dt;
         }
         for k in 0..self.slots.len() {
+            self.newton[k].set(f64::NAN);
             let c = self.slots[k].contact;
             self.diagonal[k] = if self.fixed[c] {
                 self.diagonal_fixed[c]
@@ -263,6 +270,12 @@ impl TangentialProblem {
             self.h(2 * k + 1, 2 * l),
             self.h(2 * k + 1, 2 * l + 1),
         )
+    }
+
+    /// Slot `k`'s Newton start within the step ([`crate::contact::friction::local_solve_block`]).
+    #[inline]
+    pub fn newton_start(&self, k: usize) -> &Cell<f64> {
+        &self.newton[k]
     }
 
     /// `H_kk` prepared for its local solve, formed by [`Self::assemble`].

@@ -5,6 +5,8 @@
 //! the obstacle on the structure in the contact's tangent basis, `R_T = −λ`. Sliding means
 //! `λ = μ_d R_N v/|v|` (the force opposes the slip velocity), sticking `|λ| ≤ μ_s R_N`, `v = 0`.
 
+use std::cell::Cell;
+
 use nalgebra::{Matrix2, Vector2};
 
 use crate::error::{Error, Result};
@@ -116,10 +118,13 @@ pub fn local_solve(
     mode: LocalSolve,
 ) -> (Vector2<f64>, Slide) {
     let block = DiagonalBlock::new(*h, mode == LocalSolve::Exact);
-    local_solve_block(&block, c, s_static, s_dynamic, mode)
+    local_solve_block(&block, c, s_static, s_dynamic, mode, &Cell::new(f64::NAN))
 }
 
-/// [`local_solve`] on a block prepared once per step ([`DiagonalBlock`]).
+/// [`local_solve`] on a block prepared once per step ([`DiagonalBlock`]). `newton` is the
+/// exact slip solution's Newton start: the root of the contact's last exact slip solve of
+/// this step (NaN: none), where the next one starts — the sweeps and the status iterations
+/// of a step solve the same contact with nearly the same right-hand side.
 #[inline]
 pub fn local_solve_block(
     block: &DiagonalBlock,
@@ -127,6 +132,7 @@ pub fn local_solve_block(
     s_static: f64,
     s_dynamic: f64,
     mode: LocalSolve,
+    newton: &Cell<f64>,
 ) -> (Vector2<f64>, Slide) {
     let free = block.inverse * c;
     // |free| ≤ s_static compared squared: no square root for a stick
@@ -141,7 +147,7 @@ pub fn local_solve_block(
     let lambda = match mode {
         LocalSolve::Radial => free * (s_dynamic / norm),
         LocalSolve::Exact if block.isotropic => free * (s_dynamic / norm),
-        LocalSolve::Exact => disk_boundary_solve(block, c, s_dynamic),
+        LocalSolve::Exact => disk_boundary_solve(block, c, s_dynamic, newton),
     };
     (lambda, Slide::Slip)
 }
@@ -212,7 +218,12 @@ pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
 /// `c` lies along the stiff eigenvector of an `H` anisotropic by 10³, a tube sliding round a
 /// hole) costs Newton one step down (an earlier version projected radially when the start
 /// was not below the root, off by up to 1e-4 in direction).
-fn disk_boundary_solve(block: &DiagonalBlock, c: &Vector2<f64>, s: f64) -> Vector2<f64> {
+fn disk_boundary_solve(
+    block: &DiagonalBlock,
+    c: &Vector2<f64>,
+    s: f64,
+    newton: &Cell<f64>,
+) -> Vector2<f64> {
     let h = &block.h;
     let (q, eigenvalues) = block.eigen.unwrap_or_else(|| symmetric_eigen2(h));
     let hs = [s * eigenvalues[0], s * eigenvalues[1]];
@@ -241,6 +252,12 @@ fn disk_boundary_solve(block: &DiagonalBlock, c: &Vector2<f64>, s: f64) -> Vecto
         // on the pole of a singular H: start just above it
         t = lower + f64::EPSILON * (c.norm() + hs[0].abs().max(hs[1].abs()));
     }
+    // warm start: the last root of this contact in this step (above the root, Newton's first
+    // step lands below it; below, it climbs monotonically)
+    let warm = newton.get();
+    if warm > lower {
+        t = warm;
+    }
     for _ in 0..100 {
         // φ = 1/|u| − 1, φ' = Σ u_k²/(s h_k + t) / |u|³, so the Newton step φ/φ' is
         // |u|²(1 − |u|) / Σ u_k²/(s h_k + t): three divisions.
@@ -268,6 +285,7 @@ fn disk_boundary_solve(block: &DiagonalBlock, c: &Vector2<f64>, s: f64) -> Vecto
             break;
         }
     }
+    newton.set(t);
     let [a, b] = u_of(t);
     let u = q * Vector2::new(a, b);
     let n = u.norm();

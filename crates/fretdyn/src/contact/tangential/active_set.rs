@@ -137,6 +137,7 @@ impl ActiveSet {
                         slot.s_static,
                         slot.s_dynamic,
                         LocalSolve::Exact,
+                        problem.newton_start(k),
                     )
                 };
                 if self.stick[k] {

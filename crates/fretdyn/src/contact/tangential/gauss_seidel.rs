@@ -45,6 +45,7 @@ pub fn solve(
                 slot.s_static,
                 slot.s_dynamic,
                 settings.local_solve,
+                problem.newton_start(k),
             );
             diff2 += (new - lambda[k]).norm_squared();
             norm2 += new.norm_squared();
