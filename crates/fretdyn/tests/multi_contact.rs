@@ -116,6 +116,9 @@ fn assert_sane_tube_run(label: &str, r: &RunResults, steps: u64) {
 /// 1 600 000 steps (29 s simulated, ~7 000 impacts), and which contact shows 6 % moves with the
 /// round-off of the kernels. Too long for a debug build, so this test runs with `--release`
 /// (the README's test command).
+/// One number of a contact's statistics.
+type Statistic = fn(&ContactStatistics) -> f64;
+
 #[test]
 #[cfg_attr(
     debug_assertions,
@@ -138,7 +141,7 @@ fn gauss_seidel_and_active_set_give_the_same_wear_statistics() {
     assert!(s.as_iterations_total >= s.lagrange_steps, "{s:?}");
 
     // standard error of the window's mean of `value` from the block means (batch means)
-    let standard_error = |r: &RunResults, name: &str, value: fn(&ContactStatistics) -> f64| {
+    let standard_error = |r: &RunResults, name: &str, value: Statistic| {
         let x: Vec<f64> = r
             .blocks
             .iter()
@@ -155,7 +158,7 @@ fn gauss_seidel_and_active_set_give_the_same_wear_statistics() {
     let mut worst = 0.0f64;
     for (ca, cb) in a.contacts.iter().zip(&b.contacts) {
         assert_eq!(ca.name, cb.name);
-        let quantities: [(&str, fn(&ContactStatistics) -> f64); 2] = [
+        let quantities: [(&str, Statistic); 2] = [
             ("wear rate (W)", |c| c.wear_work_rate),
             ("contact fraction", |c| c.contact_time_fraction),
         ];

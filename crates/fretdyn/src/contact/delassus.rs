@@ -213,6 +213,7 @@ impl TangentialProblem {
 
     /// Assembles `H` and `b = L q̈_free + (L q̇* − v_imp)/(θΔt)`. `v_imp(slot)` gives the
     /// obstacle's tangential velocity at a slot's contact, in its tangent basis.
+    #[inline(always)]
     pub fn assemble(
         &mut self,
         qdd_free: &[f64],
@@ -221,34 +222,45 @@ impl TangentialProblem {
         v_imp: impl Fn(&Slot) -> Vector2<f64>,
     ) {
         let p = self.p;
-        let n = 2 * self.slots.len();
+        let m = self.slots.len();
+        let st = self.stride;
         let inverse_theta_dt = 1.0 / theta_dt;
-        let mut vimp = Vector2::zeros();
-        for r in 0..n {
-            let lr_index = self.contact_row(r);
-            let lr = &self.l[lr_index * p..(lr_index + 1) * p];
-            let fixed_r = self.fixed[lr_index / 2];
-            for c in r..n {
-                let lc_index = self.contact_row(c);
-                let v = if fixed_r && self.fixed[lc_index / 2] {
-                    self.h_fixed[lr_index * self.stride + lc_index]
-                } else {
-                    crate::structure::modal::dot(lr, &self.al[lc_index * p..(lc_index + 1) * p])
-                };
-                self.h[r * self.stride + c] = v;
-                self.h[c * self.stride + r] = v;
+        for k in 0..m {
+            let ck = self.slots[k].contact;
+            let fixed_k = self.fixed[ck];
+            // the 2 × 2 blocks H_kl, l ≥ k, and their transposes
+            for l in k..m {
+                let cl = self.slots[l].contact;
+                let fixed = fixed_k && self.fixed[cl];
+                for a in 0..2 {
+                    let (hr, lr) = (2 * k + a, 2 * ck + a);
+                    for b in 0..2 {
+                        if l == k && b < a {
+                            continue; // the diagonal block's lower half, by symmetry
+                        }
+                        let (hc, lc) = (2 * l + b, 2 * cl + b);
+                        let v = if fixed {
+                            self.h_fixed[lr * st + lc]
+                        } else {
+                            crate::structure::modal::dot(
+                                &self.l[lr * p..(lr + 1) * p],
+                                &self.al[lc * p..(lc + 1) * p],
+                            )
+                        };
+                        self.h[hr * st + hc] = v;
+                        self.h[hc * st + hr] = v;
+                    }
+                }
             }
-            if r % 2 == 0 {
-                vimp = v_imp(&self.slots[r / 2]);
+            let vimp = v_imp(&self.slots[k]);
+            for a in 0..2 {
+                let lr = &self.l[(2 * ck + a) * p..(2 * ck + a + 1) * p];
+                let (acceleration, velocity) = crate::structure::modal::dot2(lr, qdd_free, qd_star);
+                self.b[2 * k + a] = acceleration + (velocity - vimp[a]) * inverse_theta_dt;
             }
-            let (acceleration, velocity) = crate::structure::modal::dot2(lr, qdd_free, qd_star);
-            self.b[r] = acceleration + (velocity - vimp[r % 2]) * inverse_theta_dt;
-        }
-        for k in 0..self.slots.len() {
             self.newton[k].set(f64::NAN);
-            let c = self.slots[k].contact;
-            self.diagonal[k] = if self.fixed[c] {
-                self.diagonal_fixed[c]
+            self.diagonal[k] = if fixed_k {
+                self.diagonal_fixed[ck]
             } else {
                 DiagonalBlock::new(self.block(k, k), self.exact)
             };
@@ -345,7 +357,7 @@ impl TangentialProblem {
     }
 
     /// `q̈ −= A⁻¹ Lᵀ λ`.
-    #[inline]
+    #[inline(always)]
     pub fn apply(&self, lambda: &[Vector2<f64>], qdd: &mut [f64]) {
         let p = self.p;
         for (k, lam) in lambda.iter().enumerate().take(self.slots.len()) {

@@ -128,7 +128,7 @@ impl CentralDifference {
     }
 
     /// Steps 1–2: positions at `n+1` and predicted velocity.
-    #[inline]
+    #[inline(always)]
     pub fn predict(&mut self) {
         let dt = self.dt;
         let h = 0.5 * dt;
@@ -142,7 +142,7 @@ impl CentralDifference {
     }
 
     /// Step 5: `q̈_free = A⁻¹ (f − K q − C q̇*)`, written to `self.qdd`.
-    #[inline]
+    #[inline(always)]
     pub fn free_acceleration(&mut self, force: &[f64]) {
         match &mut self.operators {
             Operators::Modal {
@@ -185,7 +185,7 @@ impl CentralDifference {
 
     /// Step 7: full-step velocity; returns, computed in the same pass,
     /// [`Self::energy_and_powers`] of the new state with the modal force `f`.
-    #[inline]
+    #[inline(always)]
     pub fn correct(&mut self, f: &[f64]) -> (f64, f64, f64) {
         let h = 0.5 * self.dt;
         let Operators::Modal {

@@ -301,7 +301,7 @@ pub(crate) fn check_damping_ratio(xi: f64, field: &str) -> Result<()> {
 }
 
 /// `u = Φ_c x` for one point's 3 × p rows.
-#[inline]
+#[inline(always)]
 pub fn recombine(rows: &[f64], x: &[f64]) -> Vector3<f64> {
     let p = x.len();
     Vector3::new(
@@ -312,7 +312,7 @@ pub fn recombine(rows: &[f64], x: &[f64]) -> Vector3<f64> {
 }
 
 /// `out += Φ_cᵀ f` for one point's 3 × p rows.
-#[inline]
+#[inline(always)]
 pub fn project_add(rows: &[f64], f: &Vector3<f64>, out: &mut [f64]) {
     let p = out.len();
     for (i, o) in out.iter_mut().enumerate() {
@@ -324,7 +324,7 @@ pub fn project_add(rows: &[f64], f: &Vector3<f64>, out: &mut [f64]) {
 /// (`Σ_{i ≡ j mod 4} a_i b_i`, then `(s₀ + s₁) + (s₂ + s₃)`) so that the loop vectorises and
 /// its additions do not wait on each other: the kernel of detection, `b` and the energy.
 /// Rounding differs from a left-to-right sum by round-off only.
-#[inline]
+#[inline(always)]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
@@ -344,7 +344,7 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// The two dot products `(a·b, a·c)` in one pass over `a` ([`dot`]'s summation).
-#[inline]
+#[inline(always)]
 pub fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
     let n = a.len().min(b.len()).min(c.len());
     let (a, b, c) = (&a[..n], &b[..n], &c[..n]);
@@ -365,7 +365,7 @@ pub fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
 }
 
 /// `out += s x` on equal-length slices.
-#[inline]
+#[inline(always)]
 pub fn axpy(out: &mut [f64], s: f64, x: &[f64]) {
     for (o, v) in out.iter_mut().zip(x) {
         *o += s * v;

@@ -13,6 +13,7 @@ impl Simulation<'_> {
     /// contact damping, tangential]`.
     /// `modal`: the structure's energy, modal damping power and external power
     /// ([`crate::integrator::central_difference::CentralDifference::energy_and_powers`]).
+    #[inline(always)]
     pub(super) fn energy_and_powers(&self, modal: (f64, f64, f64)) -> (f64, [f64; 4]) {
         let (mut e, modal_damping, external) = modal;
         let mut contact_damping = 0.0;

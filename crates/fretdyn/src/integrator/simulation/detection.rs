@@ -16,6 +16,7 @@ use crate::contact::frame_rows::FrameRows;
 use crate::structure::modal::{axpy, recombine};
 
 impl Simulation<'_> {
+    #[inline(always)]
     pub(super) fn external_force(&mut self, t: f64) {
         let p = self.external.len();
         let histories = self.model.loads.iter().map(|l| &l.history);
@@ -50,6 +51,7 @@ impl Simulation<'_> {
 
     /// Step 3: penetrations, frames, velocities (predicted when `predicted`) and normal
     /// forces at time `t`.
+    #[inline(always)]
     pub(super) fn detect(&mut self, t: f64, predicted: bool) {
         let velocity = if predicted {
             &self.cd.qd_star
@@ -112,6 +114,7 @@ impl Simulation<'_> {
     /// around `t_{n+1}`, as `q̇_{n+1}` is the mean of the two half-step velocities; THEORY §2),
     /// which also becomes the frame's velocity for the obstacle's power. (The tangential part
     /// of a contact [held](ContactState::held) in stick is read as exactly 0, THEORY §5.)
+    #[inline(always)]
     pub(super) fn full_step_velocities(&mut self, all: bool) {
         let p = self.cd.q.len();
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
@@ -151,7 +154,7 @@ impl ContactState {
     /// the normal law has damping, the only use of it (`R_N = K_N δ + C_N δ̇`, THEORY §3); it
     /// is 0 otherwise. The tangential one only when `tangential` (the predicted tangential
     /// velocity serves the penalty law only: the Lagrange methods form `L q̇*` themselves).
-    #[inline]
+    #[inline(always)]
     pub(super) fn set_velocity(
         &mut self,
         kinematics: Kinematics,

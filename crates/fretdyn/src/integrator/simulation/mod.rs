@@ -193,6 +193,8 @@ pub struct Simulation<'m> {
     next_sample: u64,
     /// [`Self::accumulation_bound`] of the settings.
     accumulation_bound: f64,
+    /// Run the steps as code compiled for AVX2 and FMA ([`Self::step`]).
+    wide: bool,
 }
 
 impl<'m> Simulation<'m> {
@@ -502,6 +504,7 @@ impl<'m> Simulation<'m> {
             step: 0,
             next_sample: settings.output_every,
             accumulation_bound: Self::accumulation_bound(settings),
+            wide: wide_vectors(),
         })
     }
 
@@ -543,11 +546,39 @@ impl<'m> Simulation<'m> {
     /// which bound the products the statistics form from them (THEORY §5; the divergence
     /// names the first such contact), the energy and the powers of the balance (the
     /// structure's state; no contact named), and at a sample step every value of the sample.
+    ///
+    /// On a processor with AVX2 and FMA (x86-64, detected at run time) the step runs as code
+    /// compiled for them: the same operations in the same order on wider vectors, so the
+    /// results are bit for bit those of the portable code ([`Self::use_portable_kernels`]).
     pub fn step(&mut self) -> std::result::Result<(), Divergence> {
+        #[cfg(target_arch = "x86_64")]
+        if self.wide {
+            // SAFETY: `wide` is set only when the processor has AVX2 and FMA (checked at run
+            // time in `allocate`).
+            return unsafe { self.step_avx2() };
+        }
+        self.step_portable()
+    }
+
+    /// Runs the steps with the portable (SSE2 on x86-64) code even when the processor has
+    /// AVX2: for comparisons and tests.
+    pub fn use_portable_kernels(&mut self) {
+        self.wide = false;
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn step_avx2(&mut self) -> std::result::Result<(), Divergence> {
+        self.step_portable()
+    }
+
+    #[inline(always)]
+    fn step_portable(&mut self) -> std::result::Result<(), Divergence> {
         self.try_step().inspect_err(|_| self.step -= 1)
     }
 
     /// The step; on `Err`, nothing of it was accumulated or sampled.
+    #[inline(always)]
     fn try_step(&mut self) -> std::result::Result<(), Divergence> {
         self.step += 1;
         let t = self.step as f64 * self.settings.dt;
@@ -630,4 +661,16 @@ fn contact_states<'a>(
     states: &'a mut [ContactState],
 ) -> impl Iterator<Item = (usize, (&'a crate::contact::Contact, &'a mut ContactState))> {
     model.contacts.iter().zip(states).enumerate()
+}
+
+/// Whether the processor runs AVX2 and FMA code ([`Simulation::step`]).
+fn wide_vectors() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
 }

@@ -6,6 +6,7 @@ use crate::structure::modal::project_add;
 
 impl Simulation<'_> {
     /// Step 4 (and the penalty tangential forces): modal force `f = f_ext + Σ Φ_cᵀ R_c`.
+    #[inline(always)]
     pub(super) fn contact_forces(&mut self) {
         self.force.copy_from_slice(&self.external);
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {

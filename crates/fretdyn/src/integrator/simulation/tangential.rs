@@ -15,6 +15,7 @@ use crate::model::Model;
 
 impl Simulation<'_> {
     /// Step 6 for the Lagrange methods.
+    #[inline(always)]
     pub(super) fn lagrange(&mut self) {
         let Tangential::Lagrange {
             problem,
