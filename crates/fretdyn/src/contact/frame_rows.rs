@@ -74,19 +74,20 @@ impl FrameRows {
         })
     }
 
+    #[inline(always)]
     fn p(&self) -> usize {
         self.rows.len() / 3
     }
 
     /// The row `n·Φ_c` (`a = 0`) or `t_a·Φ_c` (`a = 1, 2`).
-    #[inline]
+    #[inline(always)]
     pub fn row(&self, a: usize) -> &[f64] {
         let p = self.p();
         &self.rows[a * p..(a + 1) * p]
     }
 
     /// Signed distance `s` along the declared normal at time `t` for modal displacements `q`.
-    #[inline]
+    #[inline(always)]
     pub fn distance(&self, q: &[f64], motion: &Motion, t: f64) -> f64 {
         let s = dot(self.row(0), q) + self.offset;
         if motion.is_fixed() {
@@ -99,7 +100,7 @@ impl FrameRows {
     /// Sets the penetration and the normal of `frame` for the distance `s` (the obstacle's
     /// `frame` of THEORY §3 without the 3-D position: plane `δ = −s − g`, normal `n`; bars
     /// `δ = |s| − g`, normal `−sign(s) n`). The tangents are the fixed ones.
-    #[inline]
+    #[inline(always)]
     pub fn update(&self, s: f64, frame: &mut ContactFrame) {
         if self.two_sided {
             frame.penetration = s.abs() - self.gap;
@@ -124,7 +125,7 @@ impl FrameRows {
 
     /// Tangential velocity relative to the obstacle, `v_t = T·(Φ_c q̇ − v̄)`, for modal
     /// velocities `qd` and the obstacle's velocity `v̄`.
-    #[inline]
+    #[inline(always)]
     pub fn tangential_velocity(&self, qd: &[f64], obstacle: &Vector3<f64>) -> Vector2<f64> {
         Vector2::new(dot(self.row(1), qd), dot(self.row(2), qd))
             - Vector2::new(
@@ -135,7 +136,7 @@ impl FrameRows {
 
     /// Normal velocity relative to the obstacle along the frame's normal (positive away from
     /// the obstacle), `v_n = n·(Φ_c q̇ − v̄)`.
-    #[inline]
+    #[inline(always)]
     pub fn normal_velocity(
         &self,
         frame: &ContactFrame,
@@ -152,7 +153,7 @@ impl FrameRows {
 
     /// `f += Φ_cᵀ (R_N n + T R_T)` for the frame's normal `normal` (the declared one or its
     /// opposite).
-    #[inline]
+    #[inline(always)]
     pub fn project_add(
         &self,
         normal: &Vector3<f64>,

@@ -60,9 +60,10 @@ impl Simulation<'_> {
             // velocity over that step, so that a sticking point keeps its place on the
             // obstacle exactly; the full-step one is the mean of two such steps
             // (Motion::full_step_velocity, the velocity the slip is measured against)
-            let v = if motion.is_fixed() {
-                f.velocity
-            } else if half_step {
+            if motion.is_fixed() {
+                return Vector2::zeros();
+            }
+            let v = if half_step {
                 motion.step_velocity(step, dt)
             } else {
                 motion.full_step_velocity(step, dt)
