@@ -59,6 +59,7 @@ pub mod apps;
 
 pub mod error;
 mod files;
+mod kernels;
 
 // The README's Rust example is compiled with the doctests.
 #[cfg(doctest)]

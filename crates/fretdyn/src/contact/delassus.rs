@@ -19,6 +19,7 @@ use std::cell::Cell;
 use nalgebra::{Matrix2, Vector2, Vector3};
 
 use crate::contact::friction::{DiagonalBlock, Slide};
+use crate::kernels::{Lanes, Portable};
 
 /// One closed contact in the tangential problem.
 #[derive(Debug, Clone, Copy, Default)]
@@ -221,6 +222,18 @@ impl TangentialProblem {
         theta_dt: f64,
         v_imp: impl Fn(&Slot) -> Vector2<f64>,
     ) {
+        self.assemble_with::<Portable>(qdd_free, qd_star, theta_dt, v_imp)
+    }
+
+    /// [`Self::assemble`] with the reduction kernels `K` ([`crate::kernels`]).
+    #[inline(always)]
+    pub(crate) fn assemble_with<K: Lanes>(
+        &mut self,
+        qdd_free: &[f64],
+        qd_star: &[f64],
+        theta_dt: f64,
+        v_imp: impl Fn(&Slot) -> Vector2<f64>,
+    ) {
         let p = self.p;
         let m = self.slots.len();
         let st = self.stride;
@@ -242,7 +255,7 @@ impl TangentialProblem {
                         let v = if fixed {
                             self.h_fixed[lr * st + lc]
                         } else {
-                            crate::structure::modal::dot(
+                            K::dot(
                                 &self.l[lr * p..(lr + 1) * p],
                                 &self.al[lc * p..(lc + 1) * p],
                             )
@@ -255,7 +268,7 @@ impl TangentialProblem {
             let vimp = v_imp(&self.slots[k]);
             for a in 0..2 {
                 let lr = &self.l[(2 * ck + a) * p..(2 * ck + a + 1) * p];
-                let (acceleration, velocity) = crate::structure::modal::dot2(lr, qdd_free, qd_star);
+                let (acceleration, velocity) = K::dot2(lr, qdd_free, qd_star);
                 self.b[2 * k + a] = acceleration + (velocity - vimp[a]) * inverse_theta_dt;
             }
             self.newton[k].set(f64::NAN);

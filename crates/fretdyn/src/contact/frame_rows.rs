@@ -19,7 +19,8 @@ use nalgebra::{Vector2, Vector3};
 use crate::contact::Contact;
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::ContactFrame;
-use crate::structure::modal::{Point, axpy, dot};
+use crate::kernels::Lanes;
+use crate::structure::modal::{Point, axpy};
 
 /// The frame rows of one contact (see the module's documentation).
 #[derive(Debug, Clone, PartialEq)]
@@ -88,8 +89,8 @@ impl FrameRows {
 
     /// Signed distance `s` along the declared normal at time `t` for modal displacements `q`.
     #[inline(always)]
-    pub fn distance(&self, q: &[f64], motion: &Motion, t: f64) -> f64 {
-        let s = dot(self.row(0), q) + self.offset;
+    pub(crate) fn distance<K: Lanes>(&self, q: &[f64], motion: &Motion, t: f64) -> f64 {
+        let s = K::dot(self.row(0), q) + self.offset;
         if motion.is_fixed() {
             s
         } else {
@@ -126,8 +127,12 @@ impl FrameRows {
     /// Tangential velocity relative to the obstacle, `v_t = T·(Φ_c q̇ − v̄)`, for modal
     /// velocities `qd` and the obstacle's velocity `v̄`.
     #[inline(always)]
-    pub fn tangential_velocity(&self, qd: &[f64], obstacle: &Vector3<f64>) -> Vector2<f64> {
-        Vector2::new(dot(self.row(1), qd), dot(self.row(2), qd))
+    pub(crate) fn tangential_velocity<K: Lanes>(
+        &self,
+        qd: &[f64],
+        obstacle: &Vector3<f64>,
+    ) -> Vector2<f64> {
+        Vector2::new(K::dot(self.row(1), qd), K::dot(self.row(2), qd))
             - Vector2::new(
                 self.tangents[0].dot(obstacle),
                 self.tangents[1].dot(obstacle),
@@ -137,7 +142,7 @@ impl FrameRows {
     /// Normal velocity relative to the obstacle along the frame's normal (positive away from
     /// the obstacle), `v_n = n·(Φ_c q̇ − v̄)`.
     #[inline(always)]
-    pub fn normal_velocity(
+    pub(crate) fn normal_velocity<K: Lanes>(
         &self,
         frame: &ContactFrame,
         qd: &[f64],
@@ -148,7 +153,7 @@ impl FrameRows {
         } else {
             -1.0
         };
-        sign * (dot(self.row(0), qd) - self.normal.dot(obstacle))
+        sign * (K::dot(self.row(0), qd) - self.normal.dot(obstacle))
     }
 
     /// `f += Φ_cᵀ (R_N n + T R_T)` for the frame's normal `normal` (the declared one or its

@@ -19,6 +19,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::kernels::{Lanes, Portable};
 use crate::model::{Coordinates, Model};
 
 /// The linear operators of the coordinates.
@@ -187,6 +188,12 @@ impl CentralDifference {
     /// [`Self::energy_and_powers`] of the new state with the modal force `f`.
     #[inline(always)]
     pub fn correct(&mut self, f: &[f64]) -> (f64, f64, f64) {
+        self.correct_with::<Portable>(f)
+    }
+
+    /// [`Self::correct`] with the reduction kernels `K` ([`crate::kernels`]).
+    #[inline(always)]
+    pub(crate) fn correct_with<K: Lanes>(&mut self, f: &[f64]) -> (f64, f64, f64) {
         let h = 0.5 * self.dt;
         let Operators::Modal {
             omega2, damping, ..
@@ -197,38 +204,16 @@ impl CentralDifference {
             }
             return self.energy_and_powers(f);
         };
-        let p = self.q.len();
-        let (q, vs, a, f) = (&self.q[..p], &self.qd_star[..p], &self.qdd[..p], &f[..p]);
-        let (w2, c) = (&omega2[..p], &damping[..p]);
-        let qd = &mut self.qd[..p];
-        // four partial sums per quantity, so that the loop vectorises
-        let (mut e, mut d, mut w) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
-        let mut add = |k: usize, v: f64, q: f64, w2: f64, c: f64, f: f64| {
-            e[k] += v * v + w2 * q * q;
-            d[k] += c * v * v;
-            w[k] += f * v;
-        };
-        let full = p - p % 4;
-        let chunks = qd[..full]
-            .chunks_exact_mut(4)
-            .zip(vs.chunks_exact(4))
-            .zip(a.chunks_exact(4))
-            .zip(q.chunks_exact(4).zip(w2.chunks_exact(4)))
-            .zip(c.chunks_exact(4).zip(f.chunks_exact(4)));
-        for ((((qd, vs), a), (q, w2)), (c, f)) in chunks {
-            for k in 0..4 {
-                let v = vs[k] + h * a[k];
-                qd[k] = v;
-                add(k, v, q[k], w2[k], c[k], f[k]);
-            }
-        }
-        for (k, i) in (full..p).enumerate() {
-            let v = vs[i] + h * a[i];
-            qd[i] = v;
-            add(k, v, q[i], w2[i], c[i], f[i]);
-        }
-        let sum = |s: [f64; 4]| (s[0] + s[1]) + (s[2] + s[3]);
-        (0.5 * sum(e), sum(d), sum(w))
+        K::correct_with_energy(
+            &mut self.qd,
+            &self.qd_star,
+            &self.qdd,
+            h,
+            &self.q,
+            omega2,
+            damping,
+            f,
+        )
     }
 
     /// In one pass over the modes: the kinetic plus strain energy `½ q̇ᵀMq̇ + ½ qᵀKq`, the

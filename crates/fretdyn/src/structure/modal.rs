@@ -321,47 +321,20 @@ pub fn project_add(rows: &[f64], f: &Vector3<f64>, out: &mut [f64]) {
 }
 
 /// Dot product `a·b` of two equal-length slices, summed in four interleaved partial sums
-/// (`Σ_{i ≡ j mod 4} a_i b_i`, then `(s₀ + s₁) + (s₂ + s₃)`) so that the loop vectorises and
-/// its additions do not wait on each other: the kernel of detection, `b` and the energy.
+/// (`Σ_{i ≡ j mod 4} a_i b_i`, then `(s₀ + s₁) + (s₂ + s₃)`) so that its additions do not wait
+/// on each other: the kernel of detection, `b` and the energy (THEORY §2, "Arithmetic").
 /// Rounding differs from a left-to-right sum by round-off only.
 #[inline(always)]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut s = [0.0f64; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        s[0] += x[0] * y[0];
-        s[1] += x[1] * y[1];
-        s[2] += x[2] * y[2];
-        s[3] += x[3] * y[3];
-    }
-    for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
-        s[k] += x * y;
-    }
-    (s[0] + s[1]) + (s[2] + s[3])
+    use crate::kernels::Lanes;
+    crate::kernels::Portable::dot(a, b)
 }
 
 /// The two dot products `(a·b, a·c)` in one pass over `a` ([`dot`]'s summation).
 #[inline(always)]
 pub fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
-    let n = a.len().min(b.len()).min(c.len());
-    let (a, b, c) = (&a[..n], &b[..n], &c[..n]);
-    let (mut s, mut t) = ([0.0f64; 4], [0.0f64; 4]);
-    let (ca, cb, cc) = (a.chunks_exact(4), b.chunks_exact(4), c.chunks_exact(4));
-    let (ra, rb, rc) = (ca.remainder(), cb.remainder(), cc.remainder());
-    for ((x, y), z) in ca.zip(cb).zip(cc) {
-        for k in 0..4 {
-            s[k] += x[k] * y[k];
-            t[k] += x[k] * z[k];
-        }
-    }
-    for (k, ((x, y), z)) in ra.iter().zip(rb).zip(rc).enumerate() {
-        s[k] += x * y;
-        t[k] += x * z;
-    }
-    ((s[0] + s[1]) + (s[2] + s[3]), (t[0] + t[1]) + (t[2] + t[3]))
+    use crate::kernels::Lanes;
+    crate::kernels::Portable::dot2(a, b, c)
 }
 
 /// `out += s x` on equal-length slices.

@@ -13,6 +13,7 @@ use nalgebra::{Vector2, Vector3};
 use super::{ContactState, Simulation, Tangential, contact_rows, contact_states};
 use crate::contact::Contact;
 use crate::contact::frame_rows::FrameRows;
+use crate::kernels::Lanes;
 use crate::structure::modal::{axpy, recombine};
 
 impl Simulation<'_> {
@@ -52,7 +53,7 @@ impl Simulation<'_> {
     /// Step 3: penetrations, frames, velocities (predicted when `predicted`) and normal
     /// forces at time `t`.
     #[inline(always)]
-    pub(super) fn detect(&mut self, t: f64, predicted: bool) {
+    pub(super) fn detect<K: Lanes>(&mut self, t: f64, predicted: bool) {
         let velocity = if predicted {
             &self.cd.qd_star
         } else {
@@ -66,7 +67,7 @@ impl Simulation<'_> {
             let pt = &self.model.basis.points[c.point];
             match &self.frame_rows[k] {
                 Some(rows) => {
-                    state.distance = rows.distance(&self.cd.q, &c.motion, t);
+                    state.distance = rows.distance::<K>(&self.cd.q, &c.motion, t);
                     rows.update(state.distance, &mut state.frame);
                 }
                 None => {
@@ -85,7 +86,7 @@ impl Simulation<'_> {
             }
             match &self.frame_rows[k] {
                 Some(frame_rows) => {
-                    state.set_velocity(Kinematics::Rows(frame_rows), c, velocity, penalty);
+                    state.set_velocity::<K>(Kinematics::Rows(frame_rows), c, velocity, penalty);
                 }
                 None => {
                     let rows = if c.at_surface() {
@@ -95,7 +96,7 @@ impl Simulation<'_> {
                     } else {
                         &pt.rows[..]
                     };
-                    state.set_velocity(Kinematics::Point(rows), c, velocity, penalty);
+                    state.set_velocity::<K>(Kinematics::Point(rows), c, velocity, penalty);
                 }
             }
             state.normal_force = c.normal.force(state.frame.penetration, -state.v_normal);
@@ -115,7 +116,7 @@ impl Simulation<'_> {
     /// which also becomes the frame's velocity for the obstacle's power. (The tangential part
     /// of a contact [held](ContactState::held) in stick is read as exactly 0, THEORY §5.)
     #[inline(always)]
-    pub(super) fn full_step_velocities(&mut self, all: bool) {
+    pub(super) fn full_step_velocities<K: Lanes>(&mut self, all: bool) {
         let p = self.cd.q.len();
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
             if !(state.closed || all) {
@@ -125,7 +126,7 @@ impl Simulation<'_> {
                 state.frame.velocity = moving_full_step(&c.motion, self.step, self.settings.dt);
             }
             match &self.frame_rows[k] {
-                Some(rows) => state.set_velocity(Kinematics::Rows(rows), c, &self.cd.qd, true),
+                Some(rows) => state.set_velocity::<K>(Kinematics::Rows(rows), c, &self.cd.qd, true),
                 None => {
                     let pt = &self.model.basis.points[c.point];
                     if c.at_surface() && !state.closed {
@@ -133,7 +134,7 @@ impl Simulation<'_> {
                         c.surface_rows(pt, &state.frame.normal, out);
                     }
                     let rows = contact_rows(self.model, &self.surface_rows, k);
-                    state.set_velocity(Kinematics::Point(rows), c, &self.cd.qd, true);
+                    state.set_velocity::<K>(Kinematics::Point(rows), c, &self.cd.qd, true);
                 }
             }
         }
@@ -155,7 +156,7 @@ impl ContactState {
     /// is 0 otherwise. The tangential one only when `tangential` (the predicted tangential
     /// velocity serves the penalty law only: the Lagrange methods form `L q̇*` themselves).
     #[inline(always)]
-    pub(super) fn set_velocity(
+    pub(super) fn set_velocity<K: Lanes>(
         &mut self,
         kinematics: Kinematics,
         c: &Contact,
@@ -166,10 +167,10 @@ impl ContactState {
         match kinematics {
             Kinematics::Rows(rows) => {
                 if tangential {
-                    self.v_tangential = rows.tangential_velocity(qd, &self.frame.velocity);
+                    self.v_tangential = rows.tangential_velocity::<K>(qd, &self.frame.velocity);
                 }
                 self.v_normal = if damped {
-                    rows.normal_velocity(&self.frame, qd, &self.frame.velocity)
+                    rows.normal_velocity::<K>(&self.frame, qd, &self.frame.velocity)
                 } else {
                     0.0
                 };
@@ -178,7 +179,12 @@ impl ContactState {
                 if !(tangential || damped) {
                     return;
                 }
-                let v = recombine(rows, qd) - self.frame.velocity;
+                let p = qd.len();
+                let v = Vector3::new(
+                    K::dot(&rows[..p], qd),
+                    K::dot(&rows[p..2 * p], qd),
+                    K::dot(&rows[2 * p..3 * p], qd),
+                ) - self.frame.velocity;
                 let f = &self.frame;
                 self.v_normal = if damped { f.normal.dot(&v) } else { 0.0 };
                 if tangential {

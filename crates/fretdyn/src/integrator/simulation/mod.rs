@@ -39,6 +39,7 @@ use crate::contact::tangential::{SolverStatistics, TangentialMethod};
 use crate::error::{Error, Result};
 use crate::integrator::central_difference::CentralDifference;
 use crate::integrator::stability::stable_time_step;
+use crate::kernels::{Lanes, Portable};
 use crate::model::Model;
 use crate::results::energy::{EnergyBalance, EnergyRaw};
 use crate::results::recorder::Recorder;
@@ -511,10 +512,10 @@ impl<'m> Simulation<'m> {
     /// t = 0: contacts at the initial state, initial acceleration, first sample.
     fn start(&mut self) {
         self.external_force(0.0);
-        self.detect(0.0, false);
+        self.detect::<Portable>(0.0, false);
         self.contact_forces();
         self.cd.start(&self.force);
-        self.full_step_velocities(true);
+        self.full_step_velocities::<Portable>(true);
         for c in &mut self.contacts {
             // the velocities were the initial (full-step) ones already
             if c.closed && c.tangential_force == Vector2::zeros() {
@@ -557,7 +558,7 @@ impl<'m> Simulation<'m> {
             // time in `allocate`).
             return unsafe { self.step_avx2() };
         }
-        self.step_portable()
+        self.step_with::<Portable>()
     }
 
     /// Runs the steps with the portable (SSE2 on x86-64) code even when the processor has
@@ -569,27 +570,28 @@ impl<'m> Simulation<'m> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     unsafe fn step_avx2(&mut self) -> std::result::Result<(), Divergence> {
-        self.step_portable()
+        self.step_with::<crate::kernels::Avx2>()
     }
 
+    /// The step with the reduction kernels `K` ([`crate::kernels`]).
     #[inline(always)]
-    fn step_portable(&mut self) -> std::result::Result<(), Divergence> {
-        self.try_step().inspect_err(|_| self.step -= 1)
+    fn step_with<K: Lanes>(&mut self) -> std::result::Result<(), Divergence> {
+        self.try_step::<K>().inspect_err(|_| self.step -= 1)
     }
 
     /// The step; on `Err`, nothing of it was accumulated or sampled.
     #[inline(always)]
-    fn try_step(&mut self) -> std::result::Result<(), Divergence> {
+    fn try_step<K: Lanes>(&mut self) -> std::result::Result<(), Divergence> {
         self.step += 1;
         let t = self.step as f64 * self.settings.dt;
         self.cd.predict();
         self.external_force(t);
-        self.detect(t, true);
+        self.detect::<K>(t, true);
         self.contact_forces();
         self.cd.free_acceleration(&self.force);
-        self.lagrange();
-        let modal = self.cd.correct(&self.external);
-        self.full_step_velocities(false);
+        self.lagrange::<K>();
+        let modal = self.cd.correct_with::<K>(&self.external);
+        self.full_step_velocities::<K>(false);
 
         let dt = self.settings.dt;
         let bound = self.accumulation_bound;
@@ -609,7 +611,7 @@ impl<'m> Simulation<'m> {
         }
         let sample = self.step == self.next_sample;
         if sample {
-            self.full_step_velocities(true);
+            self.full_step_velocities::<K>(true);
             if let Some(k) = self.sample() {
                 self.recorder.discard_last();
                 return Err(diverged(Some(k)));

@@ -11,12 +11,13 @@ use crate::contact::tangential::active_set::{ActiveSet, History};
 use crate::contact::tangential::penalty::PenaltyContact;
 use crate::contact::tangential::{LocalSolve, StickVelocity, gauss_seidel};
 use crate::integrator::central_difference::CentralDifference;
+use crate::kernels::Lanes;
 use crate::model::Model;
 
 impl Simulation<'_> {
     /// Step 6 for the Lagrange methods.
     #[inline(always)]
-    pub(super) fn lagrange(&mut self) {
+    pub(super) fn lagrange<K: Lanes>(&mut self) {
         let Tangential::Lagrange {
             problem,
             solver,
@@ -53,7 +54,7 @@ impl Simulation<'_> {
         let (contacts, model, dt) = (&self.contacts, self.model, self.settings.dt);
         let half_step = self.settings.stick_velocity == StickVelocity::HalfStep;
         let step = self.step;
-        problem.assemble(&self.cd.qdd, &self.cd.qd_star, *theta_dt, |slot| {
+        problem.assemble_with::<K>(&self.cd.qdd, &self.cd.qd_star, *theta_dt, |slot| {
             let f = &contacts[slot.contact].frame;
             let motion = &model.contacts[slot.contact].motion;
             // the half-step velocity moves the point from t_{n+1} to t_{n+2}: the obstacle's

@@ -1,0 +1,357 @@
+//! The reductions over the modes that the time step runs every step — the dot products of
+//! detection, of the contacts' velocities and of `b` (THEORY §2, §3), and the energy balance's
+//! sums fused with the velocity update (THEORY §5) — in two implementations that give the same
+//! bits: portable code, and AVX2 intrinsics for x86-64 processors that have them (chosen once
+//! per run, [`crate::integrator::simulation::Simulation::step`]).
+//!
+//! Both sum in four lanes: lane `k` accumulates the terms `i ≡ k (mod 4)` of the whole chunks
+//! of four, in order; the remaining `r < 4` terms are then added to lanes `0..r`; the result is
+//! `(s₀ + s₁) + (s₂ + s₃)`. Each lane does the same multiplications and additions in the same
+//! order in both implementations (no fused multiply-add), so they agree bit for bit
+//! (tested below and in `tests/vector_width.rs`). The compiler does not turn such four-lane
+//! sums into clean vector code by itself, hence the intrinsics.
+
+/// A set of reduction kernels (see the module's documentation).
+///
+/// # Safety of [`Avx2`]
+///
+/// Its methods run AVX2 instructions: they may be called only on a processor that has AVX2
+/// (the step loop instantiates them only after checking, at run time).
+pub(crate) trait Lanes: Copy {
+    /// `a·b`.
+    fn dot(a: &[f64], b: &[f64]) -> f64;
+    /// `(a·b, a·c)` in one pass over `a`.
+    fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64);
+    /// Writes `v_i = vs_i + h a_i` to `v` and returns `(½ Σ (v_i² + w2_i q_i²), Σ c_i v_i²,
+    /// Σ f_i v_i)`: the velocity update of central differences with the structure's energy,
+    /// its damping power and the power of the force `f` (slices of equal length).
+    #[allow(clippy::too_many_arguments)]
+    fn correct_with_energy(
+        v: &mut [f64],
+        vs: &[f64],
+        a: &[f64],
+        h: f64,
+        q: &[f64],
+        w2: &[f64],
+        c: &[f64],
+        f: &[f64],
+    ) -> (f64, f64, f64);
+}
+
+/// Plain Rust, for every processor.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Portable;
+
+#[inline(always)]
+fn combine(s: [f64; 4]) -> f64 {
+    (s[0] + s[1]) + (s[2] + s[3])
+}
+
+impl Lanes for Portable {
+    #[inline(always)]
+    fn dot(a: &[f64], b: &[f64]) -> f64 {
+        let n = a.len().min(b.len());
+        let (a, b) = (&a[..n], &b[..n]);
+        let mut s = [0.0f64; 4];
+        let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+        let (ra, rb) = (ca.remainder(), cb.remainder());
+        for (x, y) in ca.zip(cb) {
+            for k in 0..4 {
+                s[k] += x[k] * y[k];
+            }
+        }
+        for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
+            s[k] += x * y;
+        }
+        combine(s)
+    }
+
+    #[inline(always)]
+    fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
+        let n = a.len().min(b.len()).min(c.len());
+        let (a, b, c) = (&a[..n], &b[..n], &c[..n]);
+        let (mut s, mut t) = ([0.0f64; 4], [0.0f64; 4]);
+        let (ca, cb, cc) = (a.chunks_exact(4), b.chunks_exact(4), c.chunks_exact(4));
+        let (ra, rb, rc) = (ca.remainder(), cb.remainder(), cc.remainder());
+        for ((x, y), z) in ca.zip(cb).zip(cc) {
+            for k in 0..4 {
+                s[k] += x[k] * y[k];
+                t[k] += x[k] * z[k];
+            }
+        }
+        for (k, ((x, y), z)) in ra.iter().zip(rb).zip(rc).enumerate() {
+            s[k] += x * y;
+            t[k] += x * z;
+        }
+        (combine(s), combine(t))
+    }
+
+    #[inline(always)]
+    fn correct_with_energy(
+        v: &mut [f64],
+        vs: &[f64],
+        a: &[f64],
+        h: f64,
+        q: &[f64],
+        w2: &[f64],
+        c: &[f64],
+        f: &[f64],
+    ) -> (f64, f64, f64) {
+        let p = v.len();
+        let (vs, a, q, w2, c, f) = (&vs[..p], &a[..p], &q[..p], &w2[..p], &c[..p], &f[..p]);
+        let (mut e, mut d, mut w) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
+        let full = p - p % 4;
+        for i in 0..p {
+            let x = vs[i] + h * a[i];
+            v[i] = x;
+            let k = if i < full { i % 4 } else { i - full };
+            e[k] += x * x + w2[i] * q[i] * q[i];
+            d[k] += c[i] * x * x;
+            w[k] += f[i] * x;
+        }
+        (0.5 * combine(e), combine(d), combine(w))
+    }
+}
+
+/// AVX2 intrinsics (x86-64 only; see the trait's safety note).
+#[cfg(target_arch = "x86_64")]
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Avx2;
+
+#[cfg(target_arch = "x86_64")]
+impl Lanes for Avx2 {
+    #[inline(always)]
+    fn dot(a: &[f64], b: &[f64]) -> f64 {
+        // SAFETY: instantiated only when the processor has AVX2 (the trait's note)
+        unsafe { avx2::dot(a, b) }
+    }
+
+    #[inline(always)]
+    fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
+        // SAFETY: as above
+        unsafe { avx2::dot2(a, b, c) }
+    }
+
+    #[inline(always)]
+    fn correct_with_energy(
+        v: &mut [f64],
+        vs: &[f64],
+        a: &[f64],
+        h: f64,
+        q: &[f64],
+        w2: &[f64],
+        c: &[f64],
+        f: &[f64],
+    ) -> (f64, f64, f64) {
+        // SAFETY: as above
+        unsafe { avx2::correct_with_energy(v, vs, a, h, q, w2, c, f) }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+// Rust 1.85 (the crate's minimum) needs `unsafe` around every intrinsic; later versions only
+// around loads and stores: the blocks are kept for the former.
+#[allow(unused_unsafe)]
+mod avx2 {
+    use std::arch::x86_64::{
+        __m256d, _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd,
+        _mm256_storeu_pd,
+    };
+
+    use super::combine;
+
+    /// The four lanes of `x`.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn lanes(x: __m256d) -> [f64; 4] {
+        let mut s = [0.0f64; 4];
+        // SAFETY: `s` holds 4 values
+        unsafe { _mm256_storeu_pd(s.as_mut_ptr(), x) };
+        s
+    }
+
+    /// [`super::Portable::dot`] on AVX2.
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn dot(a: &[f64], b: &[f64]) -> f64 {
+        let n = a.len().min(b.len());
+        let full = n - n % 4;
+        // SAFETY: AVX2 (the caller's guarantee); every load reads i..i + 4 ≤ full ≤ n
+        unsafe {
+            let mut acc = _mm256_setzero_pd();
+            let mut i = 0;
+            while i < full {
+                let x = _mm256_loadu_pd(a.as_ptr().add(i));
+                let y = _mm256_loadu_pd(b.as_ptr().add(i));
+                acc = _mm256_add_pd(acc, _mm256_mul_pd(x, y));
+                i += 4;
+            }
+            let mut s = lanes(acc);
+            for k in 0..n - full {
+                s[k] += a[full + k] * b[full + k];
+            }
+            combine(s)
+        }
+    }
+
+    /// [`super::Portable::dot2`] on AVX2.
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
+        let n = a.len().min(b.len()).min(c.len());
+        let full = n - n % 4;
+        // SAFETY: AVX2 (the caller's guarantee); every load reads i..i + 4 ≤ full ≤ n
+        unsafe {
+            let (mut s, mut t) = (_mm256_setzero_pd(), _mm256_setzero_pd());
+            let mut i = 0;
+            while i < full {
+                let x = _mm256_loadu_pd(a.as_ptr().add(i));
+                let y = _mm256_loadu_pd(b.as_ptr().add(i));
+                let z = _mm256_loadu_pd(c.as_ptr().add(i));
+                s = _mm256_add_pd(s, _mm256_mul_pd(x, y));
+                t = _mm256_add_pd(t, _mm256_mul_pd(x, z));
+                i += 4;
+            }
+            let (mut s, mut t) = (lanes(s), lanes(t));
+            for k in 0..n - full {
+                s[k] += a[full + k] * b[full + k];
+                t[k] += a[full + k] * c[full + k];
+            }
+            (combine(s), combine(t))
+        }
+    }
+
+    /// [`super::Portable::correct_with_energy`] on AVX2.
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn correct_with_energy(
+        v: &mut [f64],
+        vs: &[f64],
+        a: &[f64],
+        h: f64,
+        q: &[f64],
+        w2: &[f64],
+        c: &[f64],
+        f: &[f64],
+    ) -> (f64, f64, f64) {
+        let p = v.len();
+        let (vs, a, q, w2, c, f) = (&vs[..p], &a[..p], &q[..p], &w2[..p], &c[..p], &f[..p]);
+        let full = p - p % 4;
+        // SAFETY: AVX2 (the caller's guarantee); every load and store touches i..i + 4 ≤ p,
+        // the length of every slice
+        unsafe {
+            let hh = _mm256_set1_pd(h);
+            let (mut e, mut d, mut w) = (
+                _mm256_setzero_pd(),
+                _mm256_setzero_pd(),
+                _mm256_setzero_pd(),
+            );
+            let mut i = 0;
+            while i < full {
+                let x = _mm256_add_pd(
+                    _mm256_loadu_pd(vs.as_ptr().add(i)),
+                    _mm256_mul_pd(hh, _mm256_loadu_pd(a.as_ptr().add(i))),
+                );
+                _mm256_storeu_pd(v.as_mut_ptr().add(i), x);
+                let qi = _mm256_loadu_pd(q.as_ptr().add(i));
+                let wq = _mm256_mul_pd(_mm256_loadu_pd(w2.as_ptr().add(i)), qi);
+                e = _mm256_add_pd(e, _mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(wq, qi)));
+                let cx = _mm256_mul_pd(_mm256_loadu_pd(c.as_ptr().add(i)), x);
+                d = _mm256_add_pd(d, _mm256_mul_pd(cx, x));
+                w = _mm256_add_pd(w, _mm256_mul_pd(_mm256_loadu_pd(f.as_ptr().add(i)), x));
+                i += 4;
+            }
+            let (mut e, mut d, mut w) = (lanes(e), lanes(d), lanes(w));
+            for k in 0..p - full {
+                let i = full + k;
+                let x = vs[i] + h * a[i];
+                v[i] = x;
+                e[k] += x * x + w2[i] * q[i] * q[i];
+                d[k] += c[i] * x * x;
+                w[k] += f[i] * x;
+            }
+            (0.5 * combine(e), combine(d), combine(w))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Values of many magnitudes and signs, so that the rounding of every lane is exercised.
+    fn values(n: usize, seed: u64) -> Vec<f64> {
+        let mut x = seed.wrapping_mul(0x9e3779b97f4a7c15) | 1;
+        (0..n)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                let m = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                m * 10f64.powi((x % 13) as i32 - 6)
+            })
+            .collect()
+    }
+
+    /// The portable kernels sum as the module says: lane by lane, then pairwise.
+    #[test]
+    fn portable_lanes_are_as_documented() {
+        for n in 0..23 {
+            let (a, b) = (values(n, 1), values(n, 2));
+            let mut s = [0.0; 4];
+            let full = n - n % 4;
+            for i in 0..full {
+                s[i % 4] += a[i] * b[i];
+            }
+            for i in full..n {
+                s[i - full] += a[i] * b[i];
+            }
+            assert_eq!(
+                Portable::dot(&a, &b).to_bits(),
+                ((s[0] + s[1]) + (s[2] + s[3])).to_bits()
+            );
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_kernels_give_the_portable_bits() {
+        if !std::is_x86_feature_detected!("avx2") {
+            eprintln!("no AVX2 on this processor: nothing to compare");
+            return;
+        }
+        for n in 0..41 {
+            let [a, b, c, vs, acc, q, w2, damping, f] =
+                std::array::from_fn(|k| values(n, 10 * n as u64 + k as u64));
+            assert_eq!(
+                Avx2::dot(&a, &b).to_bits(),
+                Portable::dot(&a, &b).to_bits(),
+                "{n}"
+            );
+            let (x, y) = (Avx2::dot2(&a, &b, &c), Portable::dot2(&a, &b, &c));
+            assert_eq!(
+                (x.0.to_bits(), x.1.to_bits()),
+                (y.0.to_bits(), y.1.to_bits())
+            );
+            let (mut v1, mut v2) = (vec![0.0; n], vec![0.0; n]);
+            let e1 = Avx2::correct_with_energy(&mut v1, &vs, &acc, 0.37, &q, &w2, &damping, &f);
+            let e2 = Portable::correct_with_energy(&mut v2, &vs, &acc, 0.37, &q, &w2, &damping, &f);
+            let bits = |e: (f64, f64, f64)| (e.0.to_bits(), e.1.to_bits(), e.2.to_bits());
+            assert_eq!(bits(e1), bits(e2), "{n}");
+            assert_eq!(
+                v1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                v2.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+            );
+        }
+    }
+}
