@@ -74,6 +74,8 @@ pub struct DiagonalBlock {
     /// for the radial projection, which does not need it).
     eigen: Option<(Matrix2<f64>, [f64; 2])>,
     isotropic: bool,
+    /// `2/tr(H_ii)` ([`Self::rho`]).
+    rho: f64,
 }
 
 impl DiagonalBlock {
@@ -86,14 +88,17 @@ impl DiagonalBlock {
             inverse: inverse2(&h),
             eigen: exact.then(|| symmetric_eigen2(&h)),
             isotropic: is_isotropic(&h),
+            rho: {
+                let trace = h[(0, 0)] + h[(1, 1)];
+                if trace > 0.0 { 2.0 / trace } else { 0.0 }
+            },
         }
     }
 
     /// The step `ρ = 2/tr(H_ii)` of the natural map (THEORY §4.2), 0 for a zero block.
     #[inline]
     pub fn rho(&self) -> f64 {
-        let trace = self.h[(0, 0)] + self.h[(1, 1)];
-        if trace > 0.0 { 2.0 / trace } else { 0.0 }
+        self.rho
     }
 }
 
@@ -240,24 +245,27 @@ fn disk_boundary_solve(
         [part(0), part(1)]
     };
     let lower = -hs[0].min(hs[1]);
-    // The root lies in [|c| − s h_max, |c| − s h_min]; start from |c| minus the mean of s h_k
-    // weighted by c's components, exact to first order in s h/t (a fast slip).
-    let c2 = cp[0] * cp[0] + cp[1] * cp[1];
-    let first_order = c2.sqrt() - (cp[0] * cp[0] * hs[0] + cp[1] * cp[1] * hs[1]) / c2;
-    let mut t = lower
-        .max(c.norm() - hs[0].max(hs[1]))
-        .max(0.0)
-        .max(first_order);
-    if t <= lower {
-        // on the pole of a singular H: start just above it
-        t = lower + f64::EPSILON * (c.norm() + hs[0].abs().max(hs[1].abs()));
-    }
     // warm start: the last root of this contact in this step (above the root, Newton's first
     // step lands below it; below, it climbs monotonically)
     let warm = newton.get();
-    if warm > lower {
-        t = warm;
-    }
+    let mut t = if warm > lower {
+        warm
+    } else {
+        // The root lies in [|c| − s h_max, |c| − s h_min]; start from |c| minus the mean of
+        // s h_k weighted by c's components, exact to first order in s h/t (a fast slip).
+        let c2 = cp[0] * cp[0] + cp[1] * cp[1];
+        let first_order = c2.sqrt() - (cp[0] * cp[0] * hs[0] + cp[1] * cp[1] * hs[1]) / c2;
+        let t = lower
+            .max(c.norm() - hs[0].max(hs[1]))
+            .max(0.0)
+            .max(first_order);
+        if t <= lower {
+            // on the pole of a singular H: start just above it
+            lower + f64::EPSILON * (c.norm() + hs[0].abs().max(hs[1].abs()))
+        } else {
+            t
+        }
+    };
     for _ in 0..100 {
         // φ = 1/|u| − 1, φ' = Σ u_k²/(s h_k + t) / |u|³, so the Newton step φ/φ' is
         // |u|²(1 − |u|) / Σ u_k²/(s h_k + t): three divisions.

@@ -678,6 +678,7 @@ impl ContactStatisticsState {
     }
 
     /// Adds one step: `values[k]` for contact k, the step ending at `t`.
+    #[inline]
     pub fn step(
         &mut self,
         settings: &StatisticsSettings,

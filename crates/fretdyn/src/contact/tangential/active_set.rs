@@ -153,15 +153,20 @@ impl ActiveSet {
                         status_changed = true;
                     }
                 } else {
-                    let w = problem.residual_velocity(k, lambda);
                     let (local, local_slide) = local(lambda);
                     if local_slide == Slide::Stick {
                         self.stick[k] = true;
                         status_changed = true;
                     } else {
                         let n = local.norm();
-                        let d = if n > 0.0 { local / n } else { w / w.norm() };
-                        if (d - self.direction[k]).norm() > 1e-12 {
+                        let d = if n > 0.0 {
+                            local / n
+                        } else {
+                            let w = problem.residual_velocity(k, lambda);
+                            w / w.norm()
+                        };
+                        // |d − d_k| > 1e-12, compared squared
+                        if (d - self.direction[k]).norm_squared() > 1e-24 {
                             self.direction[k] = d;
                             direction_changed = true;
                         }

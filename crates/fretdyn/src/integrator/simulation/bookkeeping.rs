@@ -137,7 +137,7 @@ impl Simulation<'_> {
 }
 
 /// One contact's values of the step ending at `t`, for the statistics (THEORY §5).
-#[inline]
+#[inline(always)]
 pub(super) fn step_values(
     s: &ContactState,
     c: &crate::contact::Contact,
