@@ -98,19 +98,36 @@ impl Lanes for Portable {
         f: &[f64],
     ) -> (f64, f64, f64) {
         let p = v.len();
-        let (vs, a, q, w2, c, f) = (&vs[..p], &a[..p], &q[..p], &w2[..p], &c[..p], &f[..p]);
-        let (mut e, mut d, mut w) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
-        let full = p - p % 4;
-        for i in 0..p {
-            let x = vs[i] + h * a[i];
-            v[i] = x;
-            let k = if i < full { i % 4 } else { i - full };
-            e[k] += x * x + w2[i] * q[i] * q[i];
-            d[k] += c[i] * x * x;
-            w[k] += f[i] * x;
+        let (vs, a) = (&vs[..p], &a[..p]);
+        for (i, x) in v.iter_mut().enumerate() {
+            *x = vs[i] + h * a[i];
         }
-        (0.5 * combine(e), combine(d), combine(w))
+        energy_sums(v, q, w2, c, f)
     }
+}
+
+/// `(½ Σ (v_i² + w2_i q_i²), Σ c_i v_i², Σ f_i v_i)` in four lanes: the structure's energy, its
+/// damping power and the power of the force `f` for velocities `v` (the sums of
+/// [`Lanes::correct_with_energy`], without the update).
+#[inline(always)]
+pub(crate) fn energy_sums(
+    v: &[f64],
+    q: &[f64],
+    w2: &[f64],
+    c: &[f64],
+    f: &[f64],
+) -> (f64, f64, f64) {
+    let p = v.len();
+    let (q, w2, c, f) = (&q[..p], &w2[..p], &c[..p], &f[..p]);
+    let (mut e, mut d, mut w) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
+    let full = p - p % 4;
+    for i in 0..p {
+        let (x, k) = (v[i], if i < full { i % 4 } else { i - full });
+        e[k] += x * x + w2[i] * q[i] * q[i];
+        d[k] += c[i] * x * x;
+        w[k] += f[i] * x;
+    }
+    (0.5 * combine(e), combine(d), combine(w))
 }
 
 /// AVX2 intrinsics (x86-64 only; see the trait's safety note).

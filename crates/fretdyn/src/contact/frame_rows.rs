@@ -75,6 +75,12 @@ impl FrameRows {
         })
     }
 
+    /// `+1` when `normal` is the declared normal, `−1` for its opposite (the other bar).
+    #[inline(always)]
+    fn sign(&self, normal: &Vector3<f64>) -> f64 {
+        if *normal == self.normal { 1.0 } else { -1.0 }
+    }
+
     #[inline(always)]
     fn p(&self) -> usize {
         self.rows.len() / 3
@@ -148,12 +154,7 @@ impl FrameRows {
         qd: &[f64],
         obstacle: &Vector3<f64>,
     ) -> f64 {
-        let sign = if frame.normal == self.normal {
-            1.0
-        } else {
-            -1.0
-        };
-        sign * (K::dot(self.row(0), qd) - self.normal.dot(obstacle))
+        self.sign(&frame.normal) * (K::dot(self.row(0), qd) - self.normal.dot(obstacle))
     }
 
     /// `f += Φ_cᵀ (R_N n + T R_T)` for the frame's normal `normal` (the declared one or its
@@ -166,12 +167,7 @@ impl FrameRows {
         tangential: &Vector2<f64>,
         f: &mut [f64],
     ) {
-        let rn = if *normal == self.normal {
-            normal_force
-        } else {
-            -normal_force
-        };
-        axpy(f, rn, self.row(0));
+        axpy(f, self.sign(normal) * normal_force, self.row(0));
         if tangential.x != 0.0 {
             axpy(f, tangential.x, self.row(1));
         }

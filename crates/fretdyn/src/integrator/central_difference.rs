@@ -224,35 +224,7 @@ impl CentralDifference {
         match &self.operators {
             Operators::Modal {
                 omega2, damping, ..
-            } => {
-                let p = self.q.len();
-                let (q, v, f) = (&self.q[..p], &self.qd[..p], &f[..p]);
-                let (w2, c) = (&omega2[..p], &damping[..p]);
-                // four partial sums per quantity, so that the loop vectorises
-                let (mut e, mut d, mut w) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
-                let mut add = |k: usize, q: f64, v: f64, w2: f64, c: f64, f: f64| {
-                    e[k] += v * v + w2 * q * q;
-                    d[k] += c * v * v;
-                    w[k] += f * v;
-                };
-                let chunks = q
-                    .chunks_exact(4)
-                    .zip(v.chunks_exact(4))
-                    .zip(w2.chunks_exact(4))
-                    .zip(c.chunks_exact(4))
-                    .zip(f.chunks_exact(4));
-                for ((((q, v), w2), c), f) in chunks {
-                    for k in 0..4 {
-                        add(k, q[k], v[k], w2[k], c[k], f[k]);
-                    }
-                }
-                let full = p - p % 4;
-                for (k, j) in (full..p).enumerate() {
-                    add(k, q[j], v[j], w2[j], c[j], f[j]);
-                }
-                let sum = |s: [f64; 4]| (s[0] + s[1]) + (s[2] + s[3]);
-                (0.5 * sum(e), sum(d), sum(w))
-            }
+            } => crate::kernels::energy_sums(&self.qd, &self.q, omega2, damping, f),
             Operators::Dense {
                 mass,
                 stiffness,

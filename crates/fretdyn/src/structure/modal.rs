@@ -303,11 +303,17 @@ pub(crate) fn check_damping_ratio(xi: f64, field: &str) -> Result<()> {
 /// `u = Φ_c x` for one point's 3 × p rows.
 #[inline(always)]
 pub fn recombine(rows: &[f64], x: &[f64]) -> Vector3<f64> {
+    recombine_with::<crate::kernels::Portable>(rows, x)
+}
+
+/// [`recombine`] with the reduction kernels `K` ([`crate::kernels`]).
+#[inline(always)]
+pub(crate) fn recombine_with<K: crate::kernels::Lanes>(rows: &[f64], x: &[f64]) -> Vector3<f64> {
     let p = x.len();
     Vector3::new(
-        dot(&rows[..p], x),
-        dot(&rows[p..2 * p], x),
-        dot(&rows[2 * p..3 * p], x),
+        K::dot(&rows[..p], x),
+        K::dot(&rows[p..2 * p], x),
+        K::dot(&rows[2 * p..3 * p], x),
     )
 }
 

@@ -14,7 +14,7 @@ use super::{ContactState, Simulation, Tangential, contact_rows, contact_states};
 use crate::contact::Contact;
 use crate::contact::frame_rows::FrameRows;
 use crate::kernels::Lanes;
-use crate::structure::modal::{axpy, recombine};
+use crate::structure::modal::{axpy, recombine, recombine_with};
 
 impl Simulation<'_> {
     #[inline(always)]
@@ -179,12 +179,7 @@ impl ContactState {
                 if !(tangential || damped) {
                     return;
                 }
-                let p = qd.len();
-                let v = Vector3::new(
-                    K::dot(&rows[..p], qd),
-                    K::dot(&rows[p..2 * p], qd),
-                    K::dot(&rows[2 * p..3 * p], qd),
-                ) - self.frame.velocity;
+                let v = recombine_with::<K>(rows, qd) - self.frame.velocity;
                 let f = &self.frame;
                 self.v_normal = if damped { f.normal.dot(&v) } else { 0.0 };
                 if tangential {
