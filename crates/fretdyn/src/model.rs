@@ -60,6 +60,8 @@ pub struct Model {
     pub turbulence: Vec<crate::loads::TurbulentLoad>,
     /// Uniform acceleration of the base, if any (displacements are then relative to it).
     pub base_acceleration: Option<BaseAcceleration>,
+    /// Fluid-elastic forces of the flow, on the modes (THEORY §11).
+    pub fluid_elastic: Option<crate::loads::fluid_elastic::FluidElastic>,
     /// Initial state.
     pub initial: InitialState,
 }
@@ -76,6 +78,7 @@ impl Model {
             modal_loads: Vec::new(),
             turbulence: Vec::new(),
             base_acceleration: None,
+            fluid_elastic: None,
             initial: InitialState {
                 q: vec![0.0; p],
                 qdot: vec![0.0; p],
@@ -123,6 +126,9 @@ impl Model {
                     "the mass matrix is not positive definite",
                 ));
             }
+        }
+        if let Some(fe) = &self.fluid_elastic {
+            fe.validate(p)?;
         }
         let np = self.basis.points.len();
         for (k, c) in self.contacts.iter().enumerate() {

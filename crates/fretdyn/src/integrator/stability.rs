@@ -122,6 +122,12 @@ pub fn checked_stable_time_step(model: &Model, method: &TangentialMethod) -> Res
             "the highest frequency of the structure with its contacts is not a finite number: check the units of the masses, stiffnesses and sizes",
         ));
     };
+    // the fluid-elastic forces are explicit: their stiffness and damping bounds are added
+    // (conservative: the delayed stiffness as if it acted at once, THEORY §11)
+    let (w2, cmax) = match &model.fluid_elastic {
+        Some(fe) => (w2 + fe.stiffness_bound(p), cmax + fe.damping_bound(p)),
+        None => (w2, cmax),
+    };
     if w2 <= 0.0 {
         return Ok(f64::INFINITY);
     }

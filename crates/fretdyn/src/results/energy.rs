@@ -3,8 +3,9 @@
 
 use serde::Serialize;
 
-/// Discrete energy balance: `E(t) − E(0) − W_ext + D`, with `E` kinetic + strain + normal
-/// penalty potential, `W_ext` the work of external loads and `D` the energy dissipated by
+/// Discrete energy balance: `E(t) − E(0) − W_ext − W_fe + D`, with `E` kinetic + strain +
+/// normal penalty potential, `W_ext` the work of external loads, `W_fe` the work of the
+/// fluid-elastic forces and `D` the energy dissipated by
 /// modal damping, normal contact damping and the tangential forces (trapezoidal rule on the
 /// powers at full-step velocities).
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
@@ -22,24 +23,27 @@ pub struct EnergyBalance {
     /// Work done against the tangential contact forces, J (friction dissipation, plus the
     /// energy momentarily stored in tangential penalty springs).
     pub tangential: f64,
-    /// Largest `|E − E(0) − W_ext + D|` over the run divided by the largest energy scale
-    /// `max(E, E(0) + |W_ext|)` seen.
+    /// Work of the fluid-elastic forces on the structure, J: the energy the flow feeds in
+    /// (negative when the flow damps the motion; THEORY §11). Not part of `external_work`.
+    pub fluid_work: f64,
+    /// Largest `|E − E(0) − W_ext − W_fe + D|` over the run divided by the largest energy
+    /// scale `max(E, E(0) + |W_ext| + |W_fe|)` seen.
     pub relative_error: f64,
     #[serde(skip)]
     scale: f64,
     #[serde(skip)]
     max_abs: f64,
     #[serde(skip)]
-    last_powers: [f64; 4],
+    last_powers: [f64; 5],
 }
 
 /// Every number of an [`EnergyBalance`], for checkpoints.
-pub(crate) type EnergyRaw = [f64; 14];
+pub(crate) type EnergyRaw = [f64; 16];
 
 impl EnergyBalance {
     /// Starts the balance with energy `e0` and powers `[external, modal damping, contact
-    /// damping, tangential]` at t = 0.
-    pub fn start(e0: f64, powers: [f64; 4]) -> Self {
+    /// damping, tangential, fluid-elastic]` at t = 0.
+    pub fn start(e0: f64, powers: [f64; 5]) -> Self {
         Self {
             initial: e0,
             last: e0,
@@ -51,12 +55,13 @@ impl EnergyBalance {
 
     /// Adds one step of duration `dt` ending with energy `e` and `powers`.
     #[inline]
-    pub fn step(&mut self, e: f64, powers: [f64; 4], dt: f64) {
+    pub fn step(&mut self, e: f64, powers: [f64; 5], dt: f64) {
         let h = 0.5 * dt;
         self.external_work += h * (self.last_powers[0] + powers[0]);
         self.modal_damping += h * (self.last_powers[1] + powers[1]);
         self.contact_damping += h * (self.last_powers[2] + powers[2]);
         self.tangential += h * (self.last_powers[3] + powers[3]);
+        self.fluid_work += h * (self.last_powers[4] + powers[4]);
         self.last_powers = powers;
         self.last = e;
         let residual = self.residual();
@@ -64,7 +69,7 @@ impl EnergyBalance {
         self.scale = self
             .scale
             .max(e.abs())
-            .max(self.initial.abs() + self.external_work.abs());
+            .max(self.initial.abs() + self.external_work.abs() + self.fluid_work.abs());
     }
 
     /// Sets [`Self::relative_error`] from the running maxima (once, when the balance is
@@ -94,6 +99,8 @@ impl EnergyBalance {
             p[2],
             p[3],
             0.0,
+            self.fluid_work,
+            p[4],
         ]
     }
 
@@ -108,13 +115,14 @@ impl EnergyBalance {
             relative_error: r[6],
             scale: r[7],
             max_abs: r[8],
-            last_powers: [r[9], r[10], r[11], r[12]],
+            fluid_work: r[14],
+            last_powers: [r[9], r[10], r[11], r[12], r[15]],
         }
     }
 
-    /// `E − E(0) − W_ext + D` now, J.
+    /// `E − E(0) − W_ext − W_fe + D` now, J.
     pub fn residual(&self) -> f64 {
-        self.last - self.initial - self.external_work
+        self.last - self.initial - self.external_work - self.fluid_work
             + self.modal_damping
             + self.contact_damping
             + self.tangential

@@ -104,7 +104,7 @@ pub const CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNC";
 
 /// Format version of `checkpoint.bin` (1 was bincode, without a header; 2 counted the
 /// statistics' steps per contact and accumulated blocks when there were none).
-pub const CHECKPOINT_FORMAT: u32 = 3;
+pub const CHECKPOINT_FORMAT: u32 = 4;
 
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {

@@ -10,12 +10,18 @@ use crate::structure::modal::recombine;
 
 impl Simulation<'_> {
     /// Energy `E` and the powers `[external (loads and moving obstacles), modal damping,
-    /// contact damping, tangential]`.
+    /// contact damping, tangential, fluid-elastic]`.
     /// `modal`: the structure's energy, modal damping power and external power
     /// ([`crate::integrator::central_difference::CentralDifference::energy_and_powers`]).
     #[inline(always)]
-    pub(super) fn energy_and_powers(&self, modal: (f64, f64, f64)) -> (f64, [f64; 4]) {
-        let (mut e, modal_damping, external) = modal;
+    pub(super) fn energy_and_powers(&self, modal: (f64, f64, f64)) -> (f64, [f64; 5]) {
+        let (mut e, modal_damping, mut external) = modal;
+        // the external force holds the fluid-elastic one: its power apart
+        let fluid = match &self.fluid {
+            Some(f) => crate::structure::modal::dot(&f.force, &self.cd.qd),
+            None => 0.0,
+        };
+        external -= fluid;
         let mut contact_damping = 0.0;
         let mut tangential = 0.0;
         let mut obstacle = 0.0;
@@ -41,6 +47,7 @@ impl Simulation<'_> {
                 modal_damping,
                 contact_damping,
                 tangential,
+                fluid,
             ],
         )
     }

@@ -40,6 +40,7 @@ use crate::error::{Error, Result};
 use crate::integrator::central_difference::CentralDifference;
 use crate::integrator::stability::stable_time_step;
 use crate::kernels::{Lanes, Portable};
+use crate::loads::fluid_elastic::{DelayHistory, FluidElasticForce};
 use crate::model::Model;
 use crate::results::energy::{EnergyBalance, EnergyRaw};
 use crate::results::recorder::Recorder;
@@ -63,6 +64,9 @@ pub struct Snapshot {
     statistics: ContactStatisticsState,
     solver: SolverStatistics,
     energy: EnergyRaw,
+    /// The past displacements of the fluid-elastic delays.
+    #[serde(default)]
+    fluid: Option<DelayHistory>,
 }
 
 impl Snapshot {
@@ -175,6 +179,8 @@ pub struct Simulation<'m> {
     surface_rows: Vec<f64>,
     /// Per contact: the frame rows of a plane or bars, `None` for a hole.
     frame_rows: Vec<Option<FrameRows>>,
+    /// The fluid-elastic force with its past displacements, when the model has one.
+    fluid: Option<FluidElasticForce>,
     /// Modal loads `Φ_lᵀ F_l`, one row of p per load.
     load_rows: Vec<f64>,
     /// Signal generators of the turbulent loads, one per load.
@@ -295,6 +301,14 @@ impl<'m> Simulation<'m> {
         sim.statistics = snapshot.statistics;
         sim.solver_stats = snapshot.solver;
         sim.energy = EnergyBalance::from_raw(&snapshot.energy);
+        let restored = match (&mut sim.fluid, &snapshot.fluid) {
+            (None, None) => true,
+            (Some(f), Some(h)) => f.restore(h),
+            _ => false,
+        };
+        if !restored {
+            return Err(mismatch("fluid-elastic delay"));
+        }
         Ok(sim)
     }
 
@@ -325,6 +339,7 @@ impl<'m> Simulation<'m> {
             statistics: self.statistics.clone(),
             solver: self.solver_stats.clone(),
             energy: self.energy.raw(),
+            fluid: self.fluid.as_ref().map(|f| f.history()),
         }
     }
 
@@ -396,6 +411,28 @@ impl<'m> Simulation<'m> {
         let mut cd = CentralDifference::new(model, settings.dt);
         cd.q.copy_from_slice(&model.initial.q);
         cd.qd.copy_from_slice(&model.initial.qdot);
+        let fluid = match &model.fluid_elastic {
+            Some(fe) => {
+                let (needed, available) = (
+                    FluidElasticForce::ring_bytes(fe, settings.dt, p),
+                    crate::structure::beam::available_memory(),
+                );
+                if needed > 0.5 * available {
+                    return Err(Error::invalid(
+                        "flow",
+                        format!(
+                            "the fluid-elastic delay of {:e} s is {:.0} time steps: the past displacements would need {}, more than half of the {} of memory available; check the velocity (τ = μ D / U) or the time step",
+                            fe.longest_delay(),
+                            fe.longest_delay() / settings.dt,
+                            crate::structure::beam::gigabytes(needed),
+                            crate::structure::beam::gigabytes(available)
+                        ),
+                    ));
+                }
+                Some(FluidElasticForce::new(fe, settings.dt, &model.initial.q))
+            }
+            None => None,
+        };
         let mut load_rows = vec![0.0; p * model.loads.len()];
         for (l, load) in model.loads.iter().enumerate() {
             project_add(
@@ -491,6 +528,7 @@ impl<'m> Simulation<'m> {
             tangential,
             surface_rows,
             frame_rows,
+            fluid,
             load_rows,
             turbulence,
             signals: vec![0.0; channels],
@@ -512,6 +550,7 @@ impl<'m> Simulation<'m> {
     /// t = 0: contacts at the initial state, initial acceleration, first sample.
     fn start(&mut self) {
         self.external_force(0.0);
+        self.fluid_elastic_force(0, false);
         self.detect::<Portable>(0.0, false);
         self.contact_forces();
         self.cd.start(&self.force);
@@ -586,6 +625,7 @@ impl<'m> Simulation<'m> {
         let t = self.step as f64 * self.settings.dt;
         self.cd.predict();
         self.external_force(t);
+        self.fluid_elastic_force(self.step, true);
         self.detect::<K>(t, true);
         self.contact_forces();
         self.cd.free_acceleration(&self.force);
