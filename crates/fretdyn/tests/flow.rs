@@ -262,9 +262,9 @@ velocity = 2.0
     let (a, b) = (0.2, 0.7);
     for (m, n) in r.modes.iter().zip(ORDER) {
         let exact = 2.0 * (sin2(n, a, b) / (0.5 * L)).sqrt();
-        // midpoint rule with h = 5e-3: relative error O((nπh)²/24 · …) < 1e-3
+        // the midpoint rule's error, O(h²) with h = 5e-3 (measured: 1.6e-5 for n = 1)
         assert!(
-            (m.effective_velocity / exact - 1.0).abs() < 1e-3,
+            (m.effective_velocity / exact - 1.0).abs() < 1e-4,
             "mode {}: {} vs {exact}",
             m.mode,
             m.effective_velocity

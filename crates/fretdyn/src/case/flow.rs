@@ -360,6 +360,9 @@ impl ZoneSection {
         } else {
             format!("{field}.velocity_profile")
         };
+        // as given, then as gap velocities (an upstream velocity times P/(P − D) may overflow)
+        velocity.validate(&vfield)?;
+        let velocity = velocity.scaled(factor);
         velocity.validate(&vfield)?;
         let stations = line.stations(s0, s1, model);
         if let Line::Points(a) = line {
@@ -380,7 +383,7 @@ impl ZoneSection {
             name: self.name.clone(),
             span: [s0, s1],
             density,
-            velocity: velocity.scaled(factor),
+            velocity,
             stations,
         })
     }

@@ -180,16 +180,17 @@ fn v3(a: [f64; 3]) -> Vector3<f64> {
 }
 
 /// What a case file builds: the model, the settings, a tube's finite-element model, the flow.
-type Built = (Model, RunSettings, Option<Box<TubeModel>>, Option<Box<Flow>>);
+type Built = (
+    Model,
+    RunSettings,
+    Option<Box<TubeModel>>,
+    Option<Box<Flow>>,
+);
 
 impl CaseFile {
     /// The model and settings, section by section in the order of the file's schema; the
     /// first invalid value is the error.
-    fn build(
-        self,
-        base: &Path,
-        warnings: &mut Vec<String>,
-    ) -> Result<Built> {
+    fn build(self, base: &Path, warnings: &mut Vec<String>) -> Result<Built> {
         let (basis, tube, abscissae) = self.structure.build(base, warnings)?;
         basis.validate("structure")?;
         let mut model = Model::new(basis);
