@@ -8,6 +8,7 @@ mod plot;
 mod progress;
 mod results_plots;
 mod run;
+mod stability;
 mod sweep;
 mod verify;
 
@@ -99,6 +100,17 @@ enum Command {
         /// Mode shapes drawn.
         #[arg(long, default_value_t = 4)]
         shown: usize,
+    },
+    /// Connors fluid-elastic stability check of every mode of a case with a [flow] section
+    /// (docs/FLOW.md): frequency, damping, effective and critical velocities, their ratio;
+    /// printed and written as stability.json and stability.csv.
+    Stability {
+        /// Case file (TOML) with [flow] and [[flow.zones]].
+        #[arg(value_parser = path)]
+        case: PathBuf,
+        /// Output folder [default: fretdyn_results/<case name>_stability].
+        #[arg(short, long, value_parser = path)]
+        output: Option<PathBuf>,
     },
     /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube (or, with
     /// --against-c, side by side with a plain C implementation of the step).
@@ -245,6 +257,7 @@ fn main() -> ExitCode {
             output,
             shown,
         } => modes::main(&case, output, shown),
+        Command::Stability { case, output } => stability::main(&case, output),
         Command::Bench {
             steps,
             repeat,

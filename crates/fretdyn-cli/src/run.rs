@@ -89,6 +89,19 @@ fn load(path: &Path) -> Result<Case, Failure> {
     for w in &case.warnings {
         errln!("warning: {w}");
     }
+    if let Some(report) = case.stability() {
+        for m in report.unstable() {
+            errln!(
+                "warning: {}: mode {} ({:.4} Hz) is above the Connors critical velocity: U_eff/U_c = {:.4} (U_eff = {:.4} m/s, U_c = {:.4} m/s; fluid-elastic instability expected, see fretdyn stability)",
+                path.display(),
+                m.mode,
+                m.frequency_hz,
+                m.ratio.unwrap_or(f64::NAN),
+                m.effective_velocity,
+                m.critical_velocity
+            );
+        }
+    }
     Ok(case)
 }
 

@@ -8,6 +8,7 @@ use serde::Deserialize;
 
 use super::{CaseFile, TubeModel, point_index, v3};
 use crate::error::{Error, Result, number};
+use crate::loads::flow::{Flow, FlowZone};
 use crate::loads::spatial_correlation::{covariance_factor, line_covariance};
 use crate::loads::turbulence::Spectrum;
 use crate::loads::{BaseAcceleration, ModalLoad, PointLoad, Sine, TimeHistory, TurbulentLoad};
@@ -55,6 +56,9 @@ pub(super) struct ModalLoadSection {
 #[serde(deny_unknown_fields)]
 pub(super) struct TurbulenceSection {
     span: Option<[f64; 2]>,
+    /// A `[[flow.zones]]` name: the span is the zone's, and a cross-flow spectrum takes the
+    /// velocity and density it does not give from the zone (docs/FLOW.md).
+    zone: Option<String>,
     /// Directions of the force (each gets independent signals), e.g. the two transverse axes.
     directions: Vec<[f64; 3]>,
     /// Correlation length λ of `exp(−|Δs|/λ)`, m (`inf`: fully correlated).
@@ -81,8 +85,10 @@ pub(super) enum SpectrumInput {
     },
     /// Code_Aster's SPEC_LONG_COR_2 cross-flow spectrum (docs/LOADS.md).
     CrossFlow {
-        velocity: f64,
-        density: f64,
+        /// Default: the zone's (constant) gap velocity.
+        velocity: Option<f64>,
+        /// Default: the zone's density.
+        density: Option<f64>,
         /// Default: the tube's outer diameter.
         diameter: Option<f64>,
         phi0: Option<f64>,
@@ -92,8 +98,15 @@ pub(super) enum SpectrumInput {
 }
 
 impl SpectrumInput {
-    fn spectrum(&self, tube_diameter: f64) -> Spectrum {
-        match self {
+    /// The spectrum; a cross-flow spectrum takes the velocity and density it does not give
+    /// from `zone` (its gap velocity, which must then be constant, and its density).
+    fn spectrum(
+        &self,
+        tube_diameter: f64,
+        zone: Option<&FlowZone>,
+        field: &str,
+    ) -> Result<Spectrum> {
+        Ok(match self {
             SpectrumInput::Table { frequency_hz, psd } => Spectrum::Table {
                 frequency_hz: frequency_hz.clone(),
                 psd: psd.clone(),
@@ -106,6 +119,35 @@ impl SpectrumInput {
                 beta,
                 reduced_cutoff,
             } => {
+                let velocity = match (velocity, zone) {
+                    (Some(v), _) => *v,
+                    (None, Some(z)) => z.velocity.constant().ok_or_else(|| {
+                        Error::invalid(
+                            format!("{field}.spectrum.velocity"),
+                            format!(
+                                "zone '{}' has a velocity profile, and the cross-flow spectrum needs one velocity: give spectrum.velocity (m/s), or split the zone into zones of constant velocity",
+                                z.name
+                            ),
+                        )
+                    })?,
+                    (None, None) => {
+                        return Err(Error::invalid(
+                            format!("{field}.spectrum.velocity"),
+                            "give the cross-flow velocity in m/s, or zone = \"<name>\" to take it from a [[flow.zones]]",
+                        ));
+                    }
+                };
+                let density = match (density, zone) {
+                    (Some(v), _) => *v,
+                    (None, Some(z)) => z.density,
+                    (None, None) => {
+                        return Err(Error::invalid(
+                            format!("{field}.spectrum.density"),
+                            "give the fluid density in kg/m³, or zone = \"<name>\" to take it from a [[flow.zones]]",
+                        ));
+                    }
+                };
+                let (velocity, density) = (&velocity, &density);
                 let d = diameter.unwrap_or(tube_diameter);
                 let Spectrum::CrossFlow {
                     phi0: p0,
@@ -125,7 +167,7 @@ impl SpectrumInput {
                     reduced_cutoff: reduced_cutoff.unwrap_or(r0),
                 }
             }
-        }
+        })
     }
 }
 
@@ -295,6 +337,7 @@ impl CaseFile {
         &self,
         base: &Path,
         tube: Option<&TubeModel>,
+        flow: Option<&Flow>,
         model: &mut Model,
     ) -> Result<()> {
         for (k, l) in self.loads.iter().enumerate() {
@@ -362,10 +405,39 @@ impl CaseFile {
         for (k, l) in self.turbulence.iter().enumerate() {
             let field = format!("turbulence[{k}]");
             let t = tube_of(&field)?;
-            let (s0, s1) = span_of(l.span, t, &field)?;
-            let spectrum = l
-                .spectrum
-                .spectrum(t.structure.beam.tube.section.outer_diameter);
+            let zone = match &l.zone {
+                None => None,
+                Some(name) => {
+                    let names = || -> Vec<&str> {
+                        flow.map_or(Vec::new(), |f| {
+                            f.zones.iter().map(|z| z.name.as_str()).collect()
+                        })
+                    };
+                    let zone = flow.and_then(|f| f.zone(name)).ok_or_else(|| {
+                        Error::invalid(
+                            format!("{field}.zone"),
+                            format!(
+                                "unknown zone '{name}': the [[flow.zones]] are {:?}",
+                                names()
+                            ),
+                        )
+                    })?;
+                    if l.span.is_some() {
+                        return Err(Error::invalid(
+                            format!("{field}.span"),
+                            "give either span or zone (whose span it takes), not both",
+                        ));
+                    }
+                    Some(zone)
+                }
+            };
+            let (s0, s1) = match zone {
+                Some(z) => (z.span[0], z.span[1]),
+                None => span_of(l.span, t, &field)?,
+            };
+            let spectrum =
+                l.spectrum
+                    .spectrum(t.structure.beam.tube.section.outer_diameter, zone, &field)?;
             let nodes = t.structure.line_nodes(&t.basis, s0, s1);
             let (_, cells) = t.structure.line_cells(s0, s1);
             let factor = line_covariance(nodes.len(), &cells, l.correlation_length)

@@ -9,12 +9,14 @@
 //! - `contacts`: `[[contacts]]`;
 //! - `loads`: `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]`, `[[turbulence]]`,
 //!   `[base_excitation]`;
+//! - `flow`: `[flow]` and its `[[flow.zones]]`;
 //! - `settings`: `[time]`, `[tangential]`, `[output]`, `[statistics]`.
 //!
 //! This module reads the file, holds the top-level schema (`CaseFile`) and builds the
 //! sections in order.
 
 mod contacts;
+mod flow;
 mod loads;
 mod settings;
 mod structure;
@@ -22,6 +24,7 @@ mod structure;
 pub use structure::TubeModel;
 
 use contacts::ContactSection;
+use flow::FlowSection;
 use loads::{BaseSection, LineLoadSection, LoadSection, ModalLoadSection, TurbulenceSection};
 use settings::{OutputSection, StatisticsSection, TangentialSection, TimeSection};
 use structure::{InitialSection, StructureSection};
@@ -33,6 +36,7 @@ use serde::Deserialize;
 
 use crate::error::{Error, Result};
 use crate::integrator::simulation::RunSettings;
+use crate::loads::flow::{Flow, StabilityReport};
 use crate::model::Model;
 
 /// A parsed, validated case.
@@ -50,6 +54,8 @@ pub struct Case {
     pub warnings: Vec<String>,
     /// For a `type = "tube"` structure: its finite-element model and modes.
     pub tube: Option<Box<TubeModel>>,
+    /// The `[flow]` section: flow zones sampled on the modes (docs/FLOW.md).
+    pub flow: Option<Box<Flow>>,
 }
 
 impl Case {
@@ -73,13 +79,14 @@ impl Case {
         let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
         let title = file.title.clone().unwrap_or_default();
         let mut warnings = Vec::new();
-        let (model, settings, tube) = file.build(base, &mut warnings)?;
+        let (model, settings, tube, flow) = file.build(base, &mut warnings)?;
         Ok(Self {
             title,
             model,
             settings,
             echo,
             tube,
+            flow,
             warnings,
         })
     }
@@ -93,7 +100,14 @@ impl Case {
             echo: serde_json::Value::Null,
             warnings: Vec::new(),
             tube: None,
+            flow: None,
         }
+    }
+
+    /// The Connors fluid-elastic stability check of every mode (docs/FLOW.md), for a case
+    /// with a `[flow]` section.
+    pub fn stability(&self) -> Option<StabilityReport> {
+        self.flow.as_ref().map(|f| f.connors(&self.model.basis))
     }
 }
 
@@ -151,6 +165,7 @@ struct CaseFile {
     modal_loads: Vec<ModalLoadSection>,
     #[serde(default)]
     turbulence: Vec<TurbulenceSection>,
+    flow: Option<FlowSection>,
     base_excitation: Option<BaseSection>,
     #[serde(default)]
     tangential: TangentialSection,
@@ -164,23 +179,31 @@ fn v3(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
 }
 
+/// What a case file builds: the model, the settings, a tube's finite-element model, the flow.
+type Built = (
+    Model,
+    RunSettings,
+    Option<Box<TubeModel>>,
+    Option<Box<Flow>>,
+);
+
 impl CaseFile {
     /// The model and settings, section by section in the order of the file's schema; the
     /// first invalid value is the error.
-    fn build(
-        self,
-        base: &Path,
-        warnings: &mut Vec<String>,
-    ) -> Result<(Model, RunSettings, Option<Box<TubeModel>>)> {
-        let (basis, tube) = self.structure.build(base, warnings)?;
+    fn build(self, base: &Path, warnings: &mut Vec<String>) -> Result<Built> {
+        let (basis, tube, abscissae) = self.structure.build(base, warnings)?;
         basis.validate("structure")?;
         let mut model = Model::new(basis);
         self.build_contacts(tube.as_deref(), &mut model)?;
-        self.build_loads(base, tube.as_deref(), &mut model)?;
+        let flow = match &self.flow {
+            Some(f) => Some(Box::new(f.build(tube.as_deref(), &abscissae, &model)?)),
+            None => None,
+        };
+        self.build_loads(base, tube.as_deref(), flow.as_deref(), &mut model)?;
         self.build_initial(&mut model)?;
         model.validate()?;
         let settings = self.settings(&model)?;
-        Ok((model, settings, tube))
+        Ok((model, settings, tube, flow))
     }
 }
 

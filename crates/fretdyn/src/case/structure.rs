@@ -7,6 +7,7 @@ use std::path::Path;
 use nalgebra::Vector3;
 use serde::Deserialize;
 
+use super::flow::Abscissae;
 use super::{CaseFile, point_index, v3};
 use crate::error::{Error, Result, number};
 use crate::model::Model;
@@ -153,6 +154,8 @@ pub(super) struct PointInput {
     rows: Vec<Vec<f64>>,
     #[serde(default)]
     rotations: Vec<Vec<f64>>,
+    /// Abscissa along the tube, m (for `[[flow.zones]]`).
+    s: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -378,19 +381,29 @@ impl StructureSection {
         &self,
         base: &Path,
         warnings: &mut Vec<String>,
-    ) -> Result<(ModalBasis, Option<Box<TubeModel>>)> {
+    ) -> Result<(ModalBasis, Option<Box<TubeModel>>, Abscissae)> {
         if let StructureSection::Tube(t) = self {
             let structure = t.structure()?;
             let basis = structure.modal_basis()?;
             return Ok((
                 basis.basis.clone(),
                 Some(Box::new(TubeModel { structure, basis })),
+                Abscissae::default(),
             ));
         }
-        self.build_basis(base, warnings).map(|b| (b, None))
+        let mut abscissae = Abscissae::default();
+        let basis = self.build_basis(base, warnings, &mut abscissae)?;
+        abscissae.s.resize(basis.points.len(), None);
+        Ok((basis, None, abscissae))
     }
 
-    fn build_basis(&self, base: &Path, warnings: &mut Vec<String>) -> Result<ModalBasis> {
+    /// The basis, and the abscissae of its points where the case gives them.
+    fn build_basis(
+        &self,
+        base: &Path,
+        warnings: &mut Vec<String>,
+        abscissae: &mut Abscissae,
+    ) -> Result<ModalBasis> {
         match self {
             StructureSection::Tube(_) => unreachable!("handled by build"),
             StructureSection::PointMass {
@@ -407,32 +420,36 @@ impl StructureSection {
                 axial_modes,
                 damping_ratio,
                 points,
-            } => check_damping_ratio(*damping_ratio, "structure.damping_ratio")
-                .and_then(|_| {
-                    check_mode_count(
-                        modes_per_plane
-                            .saturating_mul(2)
-                            .saturating_add(*axial_modes),
-                        points.len(),
-                    )
-                })
-                .and_then(|_| {
-                    ModalBasis::pinned_beam(
-                        &PinnedBeam {
-                            length: *length,
-                            bending_stiffness: *bending_stiffness,
-                            mass_per_length: *mass_per_length,
-                            modes_per_plane: *modes_per_plane,
-                            axial_stiffness: *axial_stiffness,
-                            axial_modes: *axial_modes,
-                            damping_ratio: *damping_ratio,
-                        },
-                        &points
-                            .iter()
-                            .map(|s| (s.name.clone(), s.x))
-                            .collect::<Vec<_>>(),
-                    )
-                }),
+            } => {
+                abscissae.s = points.iter().map(|s| Some(s.x)).collect();
+                abscissae.source = "the stations' x (structure.points)".into();
+                check_damping_ratio(*damping_ratio, "structure.damping_ratio")
+                    .and_then(|_| {
+                        check_mode_count(
+                            modes_per_plane
+                                .saturating_mul(2)
+                                .saturating_add(*axial_modes),
+                            points.len(),
+                        )
+                    })
+                    .and_then(|_| {
+                        ModalBasis::pinned_beam(
+                            &PinnedBeam {
+                                length: *length,
+                                bending_stiffness: *bending_stiffness,
+                                mass_per_length: *mass_per_length,
+                                modes_per_plane: *modes_per_plane,
+                                axial_stiffness: *axial_stiffness,
+                                axial_modes: *axial_modes,
+                                damping_ratio: *damping_ratio,
+                            },
+                            &points
+                                .iter()
+                                .map(|s| (s.name.clone(), s.x))
+                                .collect::<Vec<_>>(),
+                        )
+                    })
+            }
             StructureSection::Modal {
                 frequencies_hz,
                 damping_ratio,
@@ -442,8 +459,14 @@ impl StructureSection {
             } => {
                 let mut basis = match (file, frequencies_hz) {
                     (Some(f), None) => {
-                        let file = crate::structure::basis_file::read_basis_npz(&base.join(f))?;
+                        let path = base.join(f);
+                        let file = crate::structure::basis_file::read_basis_npz(&path)?;
                         warnings.extend(file.warnings);
+                        abscissae.s = file.abscissae;
+                        abscissae.source = format!(
+                            "the arrays 's_<point>' (float64, one value, m) of {}",
+                            path.display()
+                        );
                         file.basis
                     }
                     (None, Some(freq)) => ModalBasis {
@@ -487,6 +510,19 @@ impl StructureSection {
                             ),
                         ));
                     }
+                    if abscissae.source.is_empty() {
+                        abscissae.source = "s = … (m) on the points of [structure]".into();
+                    }
+                    abscissae.s.resize(basis.points.len(), None);
+                    if let Some(s) = pt.s {
+                        if !s.is_finite() {
+                            return Err(Error::invalid(
+                                format!("structure.points[{j}].s"),
+                                format!("must be a finite abscissa in m (got {})", number(s)),
+                            ));
+                        }
+                    }
+                    abscissae.s.push(pt.s);
                     basis.points.push(Point {
                         name: pt.name.clone(),
                         coords: v3(pt.coords),

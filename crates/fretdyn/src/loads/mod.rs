@@ -9,6 +9,7 @@
 //! turbulence ([`TurbulentLoad`]) is synthesised by [`turbulence`] with the spatial
 //! correlation of [`spatial_correlation`]. See `docs/LOADS.md`.
 
+pub mod flow;
 pub mod fluid_elastic;
 pub mod spatial_correlation;
 pub mod turbulence;

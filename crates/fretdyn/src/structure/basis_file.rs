@@ -8,6 +8,8 @@
 //! - `rotations_<name>` (3, p), optional: rotation rows of point `<name>` (θx, θy, θz, rad
 //!   per unit modal coordinate), needed for a contact at the tube surface (`radius`);
 //! - `coords_<name>` (3), optional: the point's reference position, m;
+//! - `s_<name>` (1) or (), optional: the point's abscissa along the tube, m (the curvilinear
+//!   coordinate the `[[flow.zones]]` of a case are given in, docs/FLOW.md);
 //! - `participation` (3, p), optional: modal participation factors `Φᵀ M r` for unit rigid
 //!   translations along x, y, z (kg^½), needed for a base excitation.
 
@@ -55,6 +57,7 @@ pub fn read_basis_npz(path: &Path) -> Result<BasisFile> {
         vec![0.0; p]
     };
     let mut points = Vec::new();
+    let mut abscissae = Vec::new();
     for name in names.iter().filter_map(|n| n.strip_prefix("rows_")) {
         let rows: Array2<f64> = npz.by_name(&format!("rows_{name}")).map_err(|e| {
             npz_err(format!(
@@ -97,6 +100,26 @@ pub fn read_basis_npz(path: &Path) -> Result<BasisFile> {
         } else {
             Vec::new()
         };
+        let key = format!("s_{name}");
+        abscissae.push(if names.contains(&key) {
+            let s: ndarray::ArrayD<f64> = npz.by_name(&key).map_err(|e| {
+                npz_err(format!(
+                    "key '{key}' must be float64 of shape (1,) or (): {e}"
+                ))
+            })?;
+            match s.iter().next() {
+                Some(v) if s.len() == 1 && v.is_finite() => Some(*v),
+                _ => {
+                    return Err(npz_err(format!(
+                        "'{key}' must be one finite abscissa in m (got {} value(s): {:?})",
+                        s.len(),
+                        s.iter().take(3).collect::<Vec<_>>()
+                    )));
+                }
+            }
+        } else {
+            None
+        });
         points.push(Point {
             name: name.to_string(),
             coords,
@@ -174,7 +197,11 @@ pub fn read_basis_npz(path: &Path) -> Result<BasisFile> {
             ));
         }
     }
-    Ok(BasisFile { basis, warnings })
+    Ok(BasisFile {
+        basis,
+        warnings,
+        abscissae,
+    })
 }
 
 /// A modal basis read from a `.npz`, with what the reader noticed.
@@ -184,6 +211,8 @@ pub struct BasisFile {
     pub basis: ModalBasis,
     /// Accepted but doubtful things (an approximately mass-normalised basis).
     pub warnings: Vec<String>,
+    /// The abscissa along the tube of each point (key `s_<name>`), m, where given.
+    pub abscissae: Vec<Option<f64>>,
 }
 
 /// Writes a modal basis as `.npz` (keys in the module documentation).

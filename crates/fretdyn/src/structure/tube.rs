@@ -10,6 +10,7 @@
 use nalgebra::{DMatrix, Vector3};
 
 use crate::error::{Error, Result};
+use crate::loads::flow::Station;
 use crate::loads::spatial_correlation::LineCell;
 use crate::model::{Model, PhysicalMatrices};
 use crate::structure::beam::{Assembled, BeamModel, Dof, Mesh};
@@ -280,6 +281,104 @@ impl TubeStructure {
             nodes[b].weight += l * (c - sa) / (sb - sa);
         }
         nodes
+    }
+}
+
+impl TubeStructure {
+    /// Arc length `s` of every mesh node along the tube from its first node, m (along the
+    /// elements, as [`TubeStructure::line_cells`]).
+    pub fn node_abscissae(&self) -> Vec<f64> {
+        let mesh = &self.beam.mesh;
+        let mut s = vec![0.0; mesh.nodes.len()];
+        let mut acc = 0.0;
+        for [a, b] in &mesh.elements {
+            s[*a] = acc;
+            acc += (mesh.nodes[*b] - mesh.nodes[*a]).norm();
+            s[*b] = acc;
+        }
+        s
+    }
+
+    /// Quadrature stations over the arc-length span `[s0, s1]`: 4 Gauss–Legendre points on each
+    /// element's overlap with the span, with the translation rows of the axis there from the
+    /// element's own interpolation of the modes (docs/FLOW.md): along the unit tangent `t`
+    /// linear, normal to it cubic Hermite on the end translations `u⊥` and slopes `θ × t`,
+    ///
+    /// ```text
+    /// u(ξ) = [(1−ξ) u_a + ξ u_b]·t t + H₁ u⊥_a + H₂ ℓ θ_a×t + H₃ u⊥_b + H₄ ℓ θ_b×t,
+    /// H₁ = 1 − 3ξ² + 2ξ³, H₂ = ξ − 2ξ² + ξ³, H₃ = 3ξ² − 2ξ³, H₄ = ξ³ − ξ²
+    /// ```
+    ///
+    /// (exact for Euler–Bernoulli elements; the weights sum to `s1 − s0`).
+    pub fn flow_stations(&self, basis: &TubeBasis, s0: f64, s1: f64) -> Vec<Station> {
+        const GAUSS: [(f64, f64); 4] = [
+            (-0.861_136_311_594_052_6, 0.347_854_845_137_453_8),
+            (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+            (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+            (0.861_136_311_594_052_6, 0.347_854_845_137_453_8),
+        ];
+        let mesh = &self.beam.mesh;
+        let shapes = &basis.modes.shapes;
+        let p = shapes.ncols();
+        let translation = |node: usize| {
+            let pt = NamedPoint {
+                name: String::new(),
+                node,
+                offset: Vector3::zeros(),
+            };
+            point_rows(&basis.assembled, shapes, &pt)
+        };
+        let mut stations = Vec::new();
+        let mut acc = 0.0;
+        for [a, b] in &mesh.elements {
+            let d = mesh.nodes[*b] - mesh.nodes[*a];
+            let len = d.norm();
+            let (sa, sb) = (acc, acc + len);
+            acc = sb;
+            let (lo, hi) = (sa.max(s0), sb.min(s1));
+            if !(hi > lo && len > 0.0) {
+                continue;
+            }
+            let t = d / len;
+            let (ua, ub) = (translation(*a), translation(*b));
+            let (ra, rb) = (
+                rotation_rows(&basis.assembled, shapes, *a),
+                rotation_rows(&basis.assembled, shapes, *b),
+            );
+            let at = |rows: &[f64], m: usize| Vector3::new(rows[m], rows[p + m], rows[2 * p + m]);
+            let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+            for (x, w) in GAUSS {
+                let s = mid + half * x;
+                let xi = (s - sa) / len;
+                let (x2, x3) = (xi * xi, xi * xi * xi);
+                let h = [
+                    1.0 - 3.0 * x2 + 2.0 * x3,
+                    len * (xi - 2.0 * x2 + x3),
+                    3.0 * x2 - 2.0 * x3,
+                    len * (x3 - x2),
+                ];
+                let mut rows = vec![0.0; 3 * p];
+                for m in 0..p {
+                    let (va, vb) = (at(&ua, m), at(&ub, m));
+                    let axial = t * ((1.0 - xi) * va.dot(&t) + xi * vb.dot(&t));
+                    let u = axial
+                        + (va - t * va.dot(&t)) * h[0]
+                        + at(&ra, m).cross(&t) * h[1]
+                        + (vb - t * vb.dot(&t)) * h[2]
+                        + at(&rb, m).cross(&t) * h[3];
+                    for k in 0..3 {
+                        rows[k * p + m] = u[k];
+                    }
+                }
+                stations.push(Station {
+                    s,
+                    weight: w * half,
+                    rows,
+                    tangent: t,
+                });
+            }
+        }
+        stations
     }
 }
 

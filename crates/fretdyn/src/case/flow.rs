@@ -1,0 +1,427 @@
+//! `[flow]` and its `[[flow.zones]]`: the cross flow along the tube (bundle geometry, and per
+//! zone a stretch of the tube, a density and a velocity), sampled on the mode shapes for the
+//! Connors check and the loads that use the zones (docs/FLOW.md).
+
+use serde::Deserialize;
+
+use super::{TubeModel, point_index};
+use crate::error::{Error, Result, number};
+use crate::loads::flow::{
+    Bundle, BundlePattern, Flow, FlowZone, Station, VelocityDefinition, VelocityProfile,
+    midpoint_weights,
+};
+use crate::model::Model;
+
+/// `[flow]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FlowSection {
+    pattern: BundlePattern,
+    /// `P/D`.
+    pitch_ratio: f64,
+    /// Whether the zones' velocities are gap or upstream velocities.
+    velocity_definition: VelocityDefinition,
+    #[serde(default = "default_connors_constant")]
+    connors_constant: f64,
+    /// Default: the tube's outer diameter.
+    diameter: Option<f64>,
+    /// Default: the tube's mass per unit length (tube, inner fluid, added mass).
+    mass_per_length: Option<f64>,
+    zones: Vec<ZoneSection>,
+}
+
+fn default_connors_constant() -> f64 {
+    3.0
+}
+
+/// `[[flow.zones]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ZoneSection {
+    name: String,
+    span: Option<[f64; 2]>,
+    from: Option<String>,
+    to: Option<String>,
+    density: Option<f64>,
+    void_fraction: Option<f64>,
+    liquid_density: Option<f64>,
+    gas_density: Option<f64>,
+    velocity: Option<f64>,
+    /// `[[s, U], ...]`.
+    velocity_profile: Option<Vec<[f64; 2]>>,
+}
+
+/// Where the points of a structure are along the tube, for zones given by points on a
+/// structure that is not a tube (the same order as the basis's points).
+#[derive(Debug, Clone, Default)]
+pub(super) struct Abscissae {
+    /// `s` of each point of the basis, m, if known.
+    pub s: Vec<Option<f64>>,
+    /// Where the case gives them (for the messages), e.g. "the arrays 's_<name>' of b.npz".
+    pub source: String,
+}
+
+/// The geometry the zones are placed on.
+enum Line<'a> {
+    Tube(&'a TubeModel, Vec<f64>),
+    Points(&'a Abscissae),
+}
+
+impl FlowSection {
+    /// The flow, its zones sampled on the modes of `model` (`tube` for a tube structure,
+    /// `abscissae` otherwise).
+    pub(super) fn build(
+        &self,
+        tube: Option<&TubeModel>,
+        abscissae: &Abscissae,
+        model: &Model,
+    ) -> Result<Flow> {
+        if !(self.pitch_ratio.is_finite() && self.pitch_ratio > 1.0) {
+            return Err(Error::invalid(
+                "flow.pitch_ratio",
+                format!(
+                    "must be the pitch-to-diameter ratio P/D > 1 (got {})",
+                    number(self.pitch_ratio)
+                ),
+            ));
+        }
+        if !(self.connors_constant.is_finite() && self.connors_constant > 0.0) {
+            return Err(Error::invalid(
+                "flow.connors_constant",
+                format!(
+                    "must be Connors' constant K > 0 (design guides: 3.0; got {})",
+                    number(self.connors_constant)
+                ),
+            ));
+        }
+        let not_a_tube = |key: &str, what: &str| {
+            Error::invalid(
+                format!("flow.{key}"),
+                format!("give {what}: the structure is not a tube, there is no default"),
+            )
+        };
+        let diameter = match (self.diameter, tube) {
+            (Some(d), _) => d,
+            (None, Some(t)) => t.structure.beam.tube.section.outer_diameter,
+            (None, None) => return Err(not_a_tube("diameter", "the tube's outer diameter in m")),
+        };
+        let mass_per_length = match (self.mass_per_length, tube) {
+            (Some(m), _) => m,
+            (None, Some(t)) => t.structure.beam.tube.mass_per_length(),
+            (None, None) => {
+                return Err(not_a_tube(
+                    "mass_per_length",
+                    "the tube's mass per unit length in kg/m (tube, internal fluid and hydrodynamic mass)",
+                ));
+            }
+        };
+        for (key, v, what) in [
+            ("diameter", diameter, "an outer diameter > 0 in m"),
+            (
+                "mass_per_length",
+                mass_per_length,
+                "a mass per unit length > 0 in kg/m",
+            ),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::invalid(
+                    format!("flow.{key}"),
+                    format!("must be {what} (got {})", number(v)),
+                ));
+            }
+        }
+        let bundle = Bundle {
+            pattern: self.pattern,
+            pitch_ratio: self.pitch_ratio,
+        };
+        let factor = match self.velocity_definition {
+            VelocityDefinition::Gap => 1.0,
+            VelocityDefinition::Upstream => bundle.gap_factor(),
+        };
+        let line = match tube {
+            Some(t) => Line::Tube(t, t.structure.node_abscissae()),
+            None => Line::Points(abscissae),
+        };
+        let range = line.range(model)?;
+        if self.zones.is_empty() {
+            return Err(Error::invalid(
+                "flow.zones",
+                "give at least one zone: [[flow.zones]] with name, span (or from/to), density and velocity",
+            ));
+        }
+        let mut zones: Vec<(usize, FlowZone)> = Vec::new();
+        for (k, z) in self.zones.iter().enumerate() {
+            let field = format!("flow.zones[{k}]");
+            let zone = z.build(&field, &line, range, model, factor)?;
+            if let Some((j, _)) = zones.iter().find(|(_, o)| o.name == zone.name) {
+                return Err(Error::invalid(
+                    format!("{field}.name"),
+                    format!(
+                        "'{}' is already the name of flow.zones[{j}]: give each zone its own name",
+                        zone.name
+                    ),
+                ));
+            }
+            zones.push((k, zone));
+        }
+        zones.sort_by(|a, b| a.1.span[0].total_cmp(&b.1.span[0]));
+        for w in zones.windows(2) {
+            let ((_, a), (k, b)) = (&w[0], &w[1]);
+            if b.span[0] < a.span[1] {
+                return Err(Error::invalid(
+                    format!("flow.zones[{k}].span"),
+                    format!(
+                        "[{}, {}] m overlaps zone '{}' [{}, {}] m: a stretch of tube is in one zone at most",
+                        b.span[0], b.span[1], a.name, a.span[0], a.span[1]
+                    ),
+                ));
+            }
+        }
+        let whole = line.stations(range.0, range.1, model);
+        Ok(Flow {
+            bundle,
+            diameter,
+            mass_per_length,
+            connors_constant: self.connors_constant,
+            zones: zones.into_iter().map(|(_, z)| z).collect(),
+            whole,
+        })
+    }
+}
+
+impl Line<'_> {
+    /// `[s_min, s_max]` the zones may cover.
+    fn range(&self, model: &Model) -> Result<(f64, f64)> {
+        match self {
+            Line::Tube(t, _) => Ok((0.0, t.structure.length())),
+            Line::Points(a) => {
+                let known: Vec<f64> = a.s.iter().flatten().copied().collect();
+                if known.len() < 2 {
+                    let names: Vec<&str> =
+                        model.basis.points.iter().map(|p| p.name.as_str()).collect();
+                    return Err(Error::invalid(
+                        "flow",
+                        format!(
+                            "zones along a structure that is not a tube need the abscissa s (m along the tube) of its points {names:?}, at least 2 of them: give {}",
+                            a.source
+                        ),
+                    ));
+                }
+                let lo = known.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = known.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                Ok((lo, hi))
+            }
+        }
+    }
+
+    /// The abscissa of point `name`; `field` is where the case names it.
+    fn point_s(&self, name: &str, field: String, model: &Model) -> Result<f64> {
+        let i = point_index(name, field.clone(), model)?;
+        match self {
+            Line::Tube(t, s) => {
+                let pt = &t.structure.points[i];
+                Ok(s[pt.node])
+            }
+            Line::Points(a) => a.s[i].ok_or_else(|| {
+                Error::invalid(
+                    field,
+                    format!(
+                        "point '{name}' has no abscissa s along the tube: give {}",
+                        a.source
+                    ),
+                )
+            }),
+        }
+    }
+
+    /// Stations over `[s0, s1]`.
+    fn stations(&self, s0: f64, s1: f64, model: &Model) -> Vec<Station> {
+        match self {
+            Line::Tube(t, _) => t.structure.flow_stations(&t.basis, s0, s1),
+            Line::Points(a) => {
+                // every point with an abscissa, along the tube; the tangent from the
+                // neighbours' positions (zero when they coincide)
+                let mut order: Vec<(f64, usize)> =
+                    a.s.iter()
+                        .enumerate()
+                        .filter_map(|(i, s)| s.map(|s| (s, i)))
+                        .collect();
+                order.sort_by(|x, y| x.0.total_cmp(&y.0));
+                let points = &model.basis.points;
+                let n = order.len();
+                let tangent = |k: usize| {
+                    let (i, j) = (order[k.saturating_sub(1)].1, order[(k + 1).min(n - 1)].1);
+                    let d = points[j].coords - points[i].coords;
+                    let norm = d.norm();
+                    if norm > 0.0 && norm.is_finite() {
+                        d / norm
+                    } else {
+                        nalgebra::Vector3::zeros()
+                    }
+                };
+                let inside: Vec<usize> = (0..n)
+                    .filter(|&k| order[k].0 >= s0 && order[k].0 <= s1)
+                    .collect();
+                let s: Vec<f64> = inside.iter().map(|&k| order[k].0).collect();
+                let weights = midpoint_weights(&s, s0, s1);
+                inside
+                    .iter()
+                    .zip(weights)
+                    .map(|(&k, weight)| Station {
+                        s: order[k].0,
+                        weight,
+                        rows: points[order[k].1].rows.clone(),
+                        tangent: tangent(k),
+                    })
+                    .collect()
+            }
+        }
+    }
+}
+
+impl ZoneSection {
+    fn build(
+        &self,
+        field: &str,
+        line: &Line,
+        (lo, hi): (f64, f64),
+        model: &Model,
+        factor: f64,
+    ) -> Result<FlowZone> {
+        let name_ok = !self.name.is_empty()
+            && self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'));
+        if !name_ok {
+            return Err(Error::invalid(
+                format!("{field}.name"),
+                format!(
+                    "'{}': a zone name is letters, digits, '_', '-' and '.' (it heads columns and rows of the outputs)",
+                    self.name
+                ),
+            ));
+        }
+        let span = match (&self.span, &self.from, &self.to) {
+            (Some(s), None, None) => *s,
+            (None, Some(a), Some(b)) => [
+                line.point_s(a, format!("{field}.from"), model)?,
+                line.point_s(b, format!("{field}.to"), model)?,
+            ],
+            _ => {
+                return Err(Error::invalid(
+                    field,
+                    "give the stretch of tube either as span = [s0, s1] (m along the tube) or as from = \"point\", to = \"point\"",
+                ));
+            }
+        };
+        let [s0, s1] = span;
+        let key = if self.span.is_some() { "span" } else { "from" };
+        let tol = 1e-12 * (hi - lo).abs().max(1.0);
+        if !(s0.is_finite() && s1.is_finite() && s0 < s1) {
+            return Err(Error::invalid(
+                format!("{field}.{key}"),
+                format!(
+                    "gives [{}, {}] m: the zone needs s0 < s1 along the tube",
+                    number(s0),
+                    number(s1)
+                ),
+            ));
+        }
+        if s0 < lo - tol || s1 > hi + tol {
+            return Err(Error::invalid(
+                format!("{field}.{key}"),
+                format!(
+                    "[{}, {}] m is outside the tube, which runs over [{}, {}] m: keep the zone on it",
+                    number(s0),
+                    number(s1),
+                    number(lo),
+                    number(hi)
+                ),
+            ));
+        }
+        let (s0, s1) = (s0.max(lo), s1.min(hi));
+        let density = self.density(field)?;
+        let velocity = match (self.velocity, &self.velocity_profile) {
+            (Some(u), None) => VelocityProfile::Constant(u),
+            (None, Some(rows)) => VelocityProfile::Table {
+                s: rows.iter().map(|r| r[0]).collect(),
+                velocity: rows.iter().map(|r| r[1]).collect(),
+            },
+            _ => {
+                return Err(Error::invalid(
+                    field,
+                    "give either velocity = U (m/s) or velocity_profile = [[s, U], ...] (m, m/s; linear in s)",
+                ));
+            }
+        };
+        let vfield = if self.velocity.is_some() {
+            format!("{field}.velocity")
+        } else {
+            format!("{field}.velocity_profile")
+        };
+        // as given, then as gap velocities (an upstream velocity times P/(P − D) may overflow)
+        velocity.validate(&vfield)?;
+        let velocity = velocity.scaled(factor);
+        velocity.validate(&vfield)?;
+        let stations = line.stations(s0, s1, model);
+        if let Line::Points(a) = line {
+            if stations.len() < 2 {
+                return Err(Error::invalid(
+                    format!("{field}.{key}"),
+                    format!(
+                        "[{}, {}] m holds {} point(s) with an abscissa: at least 2 are needed to integrate along the zone (give more points, with {})",
+                        number(s0),
+                        number(s1),
+                        stations.len(),
+                        a.source
+                    ),
+                ));
+            }
+        }
+        Ok(FlowZone {
+            name: self.name.clone(),
+            span: [s0, s1],
+            density,
+            velocity,
+            stations,
+        })
+    }
+
+    /// `ρ`, or `(1 − α) ρ_l + α ρ_g` (homogeneous two-phase density).
+    fn density(&self, field: &str) -> Result<f64> {
+        let check = |v: f64, key: &str, what: &str| {
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(Error::invalid(
+                    format!("{field}.{key}"),
+                    format!("must be {what} (got {})", number(v)),
+                ))
+            }
+        };
+        match (
+            self.density,
+            self.void_fraction,
+            self.liquid_density,
+            self.gas_density,
+        ) {
+            (Some(rho), None, None, None) => check(rho, "density", "a fluid density > 0 in kg/m³"),
+            (None, Some(alpha), Some(rl), Some(rg)) => {
+                if !(alpha.is_finite() && (0.0..=1.0).contains(&alpha)) {
+                    return Err(Error::invalid(
+                        format!("{field}.void_fraction"),
+                        format!("must be in [0, 1] (got {})", number(alpha)),
+                    ));
+                }
+                let rl = check(rl, "liquid_density", "a density > 0 in kg/m³")?;
+                let rg = check(rg, "gas_density", "a density > 0 in kg/m³")?;
+                Ok((1.0 - alpha) * rl + alpha * rg)
+            }
+            _ => Err(Error::invalid(
+                field,
+                "give either density = ρ (kg/m³) or void_fraction, liquid_density and gas_density (homogeneous two-phase density (1 − α) ρ_l + α ρ_g)",
+            )),
+        }
+    }
+}

@@ -1,0 +1,462 @@
+//! Cross flow along a tube: flow zones (a stretch of the tube, a fluid density, a gap velocity
+//! that may vary along it, the mode shapes sampled along it) and the Connors fluid-elastic
+//! stability check of every mode. `docs/FLOW.md` states the definitions, their sources and
+//! their limits.
+//!
+//! A zone holds what a per-zone force model needs to project a force per unit length on the
+//! modes once, before the run: quadrature stations `(s_k, w_k)` along its stretch with the
+//! translation rows `Φ(s_k)` (3 × p) and the tube's unit tangent `t(s_k)` there, so that
+//! `∫_zone g(s) φ_i(s)·φ_j(s) ds ≈ Σ_k w_k g(s_k) φ_i(s_k)·φ_j(s_k)`.
+//!
+//! Connors check (Pettigrew & Taylor 2003, Part 1, eqs. for the effective velocity; ASME
+//! Boiler and Pressure Vessel Code, Section III, Appendix N-1330), per mode `i`:
+//!
+//! ```text
+//! U_eff² = ∫ ρ(s) U(s)² φ(s)² ds / (ρ_ref ∫ (m(s)/m_ref) φ(s)² ds)
+//! U_c    = K f D √(m_ref δ / (ρ_ref D²)),   δ = 2π ζ
+//! ratio  = U_eff / U_c
+//! ```
+//!
+//! with `φ(s)²` the squared transverse displacement (both directions normal to the tube's axis),
+//! `U` the gap velocity, the numerator over the zones and the denominator over the whole tube,
+//! `ρ_ref` the density of the zone with the largest `∫ρU²φ²` of the mode and `m_ref` the
+//! (uniform) mass per unit length of the tube with its internal fluid and hydrodynamic mass.
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result, number};
+use crate::structure::modal::ModalBasis;
+
+/// Tube bundle pattern (the angle between the flow and the pitch lines).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BundlePattern {
+    /// Square, flow along a pitch line (90°).
+    InLineSquare,
+    /// Square rotated by 45°.
+    RotatedSquare,
+    /// Triangle with the flow normal to a side (30°).
+    NormalTriangle,
+    /// Triangle with the flow parallel to a side (60°).
+    ParallelTriangle,
+}
+
+/// What velocity the case gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VelocityDefinition {
+    /// The gap velocity `U_g = U_∞ P/(P − D)` (the "pitch velocity" `V_p` of Pettigrew &
+    /// Taylor, the "gap velocity" of ASME N-1331), the velocity of the Connors check.
+    Gap,
+    /// The upstream (free-stream, approach) velocity `U_∞`; the gap velocity is
+    /// `U_∞ P/(P − D)`.
+    Upstream,
+}
+
+/// The bundle's geometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bundle {
+    /// Pattern.
+    pub pattern: BundlePattern,
+    /// Pitch-to-diameter ratio `P/D` (> 1).
+    pub pitch_ratio: f64,
+}
+
+impl Bundle {
+    /// `U_g / U_∞ = P/(P − D) = r/(r − 1)`, `r = P/D`.
+    pub fn gap_factor(&self) -> f64 {
+        self.pitch_ratio / (self.pitch_ratio - 1.0)
+    }
+}
+
+/// Gap velocity along a zone, m/s.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VelocityProfile {
+    /// The same everywhere.
+    Constant(f64),
+    /// `(s_k, U_k)` with strictly increasing `s_k`, linear between rows, held at the end values
+    /// beyond them.
+    Table {
+        /// Abscissae along the tube, m.
+        s: Vec<f64>,
+        /// Gap velocities, m/s (≥ 0).
+        velocity: Vec<f64>,
+    },
+}
+
+impl VelocityProfile {
+    /// `U(s)`, m/s.
+    pub fn at(&self, s: f64) -> f64 {
+        match self {
+            VelocityProfile::Constant(u) => *u,
+            VelocityProfile::Table { s: xs, velocity } => {
+                let n = xs.len();
+                if s <= xs[0] {
+                    return velocity[0];
+                }
+                if s >= xs[n - 1] {
+                    return velocity[n - 1];
+                }
+                let i = xs.partition_point(|&x| x <= s);
+                let (x0, x1, u0, u1) = (xs[i - 1], xs[i], velocity[i - 1], velocity[i]);
+                u0 + (u1 - u0) * (s - x0) / (x1 - x0)
+            }
+        }
+    }
+
+    /// The velocity if it is the same everywhere.
+    pub fn constant(&self) -> Option<f64> {
+        match self {
+            VelocityProfile::Constant(u) => Some(*u),
+            VelocityProfile::Table { .. } => None,
+        }
+    }
+
+    /// Multiplies every velocity by `factor`.
+    pub fn scaled(self, factor: f64) -> Self {
+        match self {
+            VelocityProfile::Constant(u) => VelocityProfile::Constant(u * factor),
+            VelocityProfile::Table { s, velocity } => VelocityProfile::Table {
+                s,
+                velocity: velocity.into_iter().map(|u| u * factor).collect(),
+            },
+        }
+    }
+
+    /// Checks the values; `field` is where the case gives them.
+    pub fn validate(&self, field: &str) -> Result<()> {
+        let check_u = |u: f64, field: String| {
+            if u.is_finite() && u >= 0.0 {
+                Ok(())
+            } else {
+                Err(Error::invalid(
+                    field,
+                    format!("must be a finite velocity ≥ 0 in m/s (got {})", number(u)),
+                ))
+            }
+        };
+        match self {
+            VelocityProfile::Constant(u) => check_u(*u, field.to_string()),
+            VelocityProfile::Table { s, velocity } => {
+                if s.len() < 2 || s.len() != velocity.len() {
+                    return Err(Error::invalid(
+                        field,
+                        format!(
+                            "needs at least 2 rows [s, U] to interpolate (got {})",
+                            s.len()
+                        ),
+                    ));
+                }
+                for k in 0..s.len() {
+                    let row = format!("{field}[{k}]");
+                    if !s[k].is_finite() {
+                        return Err(Error::invalid(
+                            row,
+                            format!("s = {} must be a finite abscissa in m", number(s[k])),
+                        ));
+                    }
+                    if k > 0 && !(s[k] > s[k - 1]) {
+                        return Err(Error::invalid(
+                            row,
+                            format!(
+                                "s = {} m is not after the previous row's {} m: the rows [s, U] must have strictly increasing s",
+                                number(s[k]),
+                                number(s[k - 1])
+                            ),
+                        ));
+                    }
+                    check_u(velocity[k], row)?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// A quadrature point along the tube.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Station {
+    /// Abscissa along the tube, m.
+    pub s: f64,
+    /// Quadrature weight, m (`Σ w = ` the length covered).
+    pub weight: f64,
+    /// Translation rows of the tube's axis there, row-major 3 × p (as [`crate::structure::modal::Point::rows`]).
+    pub rows: Vec<f64>,
+    /// Unit tangent of the tube's axis (zero when unknown: then the whole translation counts
+    /// as transverse).
+    pub tangent: Vector3<f64>,
+}
+
+impl Station {
+    /// Translation of mode `i` at the station.
+    pub fn translation(&self, i: usize) -> Vector3<f64> {
+        let p = self.rows.len() / 3;
+        Vector3::new(self.rows[i], self.rows[p + i], self.rows[2 * p + i])
+    }
+
+    /// `|u − (u·t) t|²` of mode `i`: the squared displacement normal to the axis.
+    pub fn transverse_square(&self, i: usize) -> f64 {
+        let u = self.translation(i);
+        let t = self.tangent;
+        (u - t * u.dot(&t)).norm_squared()
+    }
+}
+
+/// Quadrature weights of stations at the sorted abscissae `s` covering `[a, b]` (a midpoint
+/// rule: each station carries from the midpoint with its neighbour before to the one after,
+/// the first from `a`, the last to `b`).
+pub fn midpoint_weights(s: &[f64], a: f64, b: f64) -> Vec<f64> {
+    let n = s.len();
+    (0..n)
+        .map(|k| {
+            let lo = if k == 0 { a } else { 0.5 * (s[k - 1] + s[k]) };
+            let hi = if k + 1 == n {
+                b
+            } else {
+                0.5 * (s[k] + s[k + 1])
+            };
+            hi - lo
+        })
+        .collect()
+}
+
+/// A stretch of the tube in a uniform-density cross flow.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowZone {
+    /// Name (letters, digits, `_`, `-`, `.`).
+    pub name: String,
+    /// `[s0, s1]`, m along the tube.
+    pub span: [f64; 2],
+    /// Fluid density (homogeneous two-phase density allowed), kg/m³.
+    pub density: f64,
+    /// Gap velocity along the zone.
+    pub velocity: VelocityProfile,
+    /// Quadrature stations over the span with the mode shapes.
+    pub stations: Vec<Station>,
+}
+
+impl FlowZone {
+    /// `(∫ ρ U² φ_i² ds, ∫ φ_i² ds)` over the zone for mode `i`.
+    pub fn integrals(&self, i: usize) -> (f64, f64) {
+        let (mut a, mut b) = (0.0, 0.0);
+        for st in &self.stations {
+            let u = self.velocity.at(st.s);
+            let w = st.weight * st.transverse_square(i);
+            a += self.density * u * u * w;
+            b += w;
+        }
+        (a, b)
+    }
+}
+
+/// The flow over a tube: bundle, zones, and what the Connors check needs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Flow {
+    /// Bundle geometry.
+    pub bundle: Bundle,
+    /// Tube outer diameter `D`, m.
+    pub diameter: f64,
+    /// `m_ref`: the tube's mass per unit length (tube, internal fluid, hydrodynamic mass), kg/m,
+    /// uniform along the tube.
+    pub mass_per_length: f64,
+    /// Connors' constant `K`.
+    pub connors_constant: f64,
+    /// The zones, sorted along the tube, not overlapping.
+    pub zones: Vec<FlowZone>,
+    /// Stations over the whole tube (the denominator `∫ φ² ds` of `U_eff²`).
+    pub whole: Vec<Station>,
+}
+
+/// `U_c = K f D √(m δ / (ρ D²))`, `δ = 2π ζ` (Connors; Pettigrew & Taylor 2003): the critical
+/// gap velocity of fluid-elastic instability, m/s, of a mode of frequency `f` (Hz) and damping
+/// ratio `ζ`, mass per unit length `m` (kg/m), fluid density `ρ` (kg/m³), diameter `D` (m).
+pub fn connors_critical_velocity(f: f64, zeta: f64, m: f64, rho: f64, d: f64, k: f64) -> f64 {
+    let delta = std::f64::consts::TAU * zeta;
+    k * f * d * (m * delta / (rho * d * d)).sqrt()
+}
+
+/// The Connors check of one mode.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeStability {
+    /// Mode number, from 1.
+    pub mode: usize,
+    /// Natural frequency `f`, Hz.
+    pub frequency_hz: f64,
+    /// Damping ratio `ζ` (`δ = 2πζ`).
+    pub damping_ratio: f64,
+    /// The zone whose density is `ρ_ref` (largest `∫ρU²φ²`).
+    pub reference_zone: String,
+    /// `ρ_ref`, kg/m³.
+    pub reference_density: f64,
+    /// `U_eff`, m/s.
+    pub effective_velocity: f64,
+    /// `U_c`, m/s.
+    pub critical_velocity: f64,
+    /// `U_eff / U_c`; `None` when undefined (`U_eff = U_c = 0`).
+    pub ratio: Option<f64>,
+}
+
+impl ModeStability {
+    /// `U_eff / U_c > 1` (an undamped mode in a flow is unstable).
+    pub fn unstable(&self) -> bool {
+        self.ratio.is_some_and(|r| r > 1.0)
+    }
+}
+
+/// The Connors check of every mode, with the constants used.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StabilityReport {
+    /// `K`.
+    pub connors_constant: f64,
+    /// `D`, m.
+    pub diameter: f64,
+    /// `m_ref`, kg/m.
+    pub mass_per_length: f64,
+    /// Per mode.
+    pub modes: Vec<ModeStability>,
+}
+
+/// Columns of [`StabilityReport::to_csv`].
+pub const STABILITY_CSV_HEADER: &str = "mode,frequency_hz,damping_ratio,reference_zone,reference_density,effective_velocity,critical_velocity,ratio";
+
+impl StabilityReport {
+    /// The modes whose ratio exceeds 1.
+    pub fn unstable(&self) -> impl Iterator<Item = &ModeStability> {
+        self.modes.iter().filter(|m| m.unstable())
+    }
+
+    /// One row per mode under [`STABILITY_CSV_HEADER`]; numbers in Rust's shortest round-trip
+    /// form, an undefined or infinite ratio as an empty field or `inf`. Zone names need no
+    /// quoting (letters, digits, `_`, `-`, `.` only).
+    pub fn to_csv(&self) -> String {
+        let mut text = format!("{STABILITY_CSV_HEADER}\n");
+        for m in &self.modes {
+            text.push_str(&format!(
+                "{},{},{},{},{},{},{},{}\n",
+                m.mode,
+                m.frequency_hz,
+                m.damping_ratio,
+                m.reference_zone,
+                m.reference_density,
+                m.effective_velocity,
+                m.critical_velocity,
+                m.ratio.map(|r| r.to_string()).unwrap_or_default()
+            ));
+        }
+        text
+    }
+}
+
+impl Flow {
+    /// The Connors check of every mode of `basis` (the module documentation has the formulas).
+    /// Modes are those whose rows the stations hold (the basis's).
+    pub fn connors(&self, basis: &ModalBasis) -> StabilityReport {
+        let modes = (0..basis.modes())
+            .map(|i| {
+                // ∫ m/m_ref φ² over the whole tube: m is uniform, the ratio is 1
+                let norm: f64 = self
+                    .whole
+                    .iter()
+                    .map(|st| st.weight * st.transverse_square(i))
+                    .sum();
+                let mut numerator = 0.0;
+                // ρ_ref: the zone of largest ∫ρU²φ² (ties: the first; a mode no zone loads:
+                // the zone of largest ∫ρφ²)
+                let mut reference = (f64::NEG_INFINITY, f64::NEG_INFINITY, 0usize);
+                for (z, zone) in self.zones.iter().enumerate() {
+                    let (a, b) = zone.integrals(i);
+                    numerator += a;
+                    let key = (a, zone.density * b, z);
+                    if (key.0, key.1) > (reference.0, reference.1) {
+                        reference = key;
+                    }
+                }
+                let zone = &self.zones[reference.2];
+                let rho_ref = zone.density;
+                let effective = if numerator > 0.0 && norm > 0.0 {
+                    (numerator / (rho_ref * norm)).sqrt()
+                } else {
+                    0.0
+                };
+                let f = basis.omega[i] / std::f64::consts::TAU;
+                let zeta = basis.damping_ratio[i];
+                let critical = connors_critical_velocity(
+                    f,
+                    zeta,
+                    self.mass_per_length,
+                    rho_ref,
+                    self.diameter,
+                    self.connors_constant,
+                );
+                let ratio = if effective == 0.0 {
+                    (critical > 0.0).then_some(0.0)
+                } else {
+                    Some(effective / critical)
+                };
+                ModeStability {
+                    mode: i + 1,
+                    frequency_hz: f,
+                    damping_ratio: zeta,
+                    reference_zone: zone.name.clone(),
+                    reference_density: rho_ref,
+                    effective_velocity: effective,
+                    critical_velocity: critical,
+                    ratio,
+                }
+            })
+            .collect();
+        StabilityReport {
+            connors_constant: self.connors_constant,
+            diameter: self.diameter,
+            mass_per_length: self.mass_per_length,
+            modes,
+        }
+    }
+
+    /// The zone named `name`.
+    pub fn zone(&self, name: &str) -> Option<&FlowZone> {
+        self.zones.iter().find(|z| z.name == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flow_profile_interpolates_and_holds_its_ends() {
+        let p = VelocityProfile::Table {
+            s: vec![1.0, 2.0, 4.0],
+            velocity: vec![1.0, 3.0, 2.0],
+        };
+        assert_eq!(p.at(0.0), 1.0);
+        assert_eq!(p.at(1.5), 2.0);
+        assert_eq!(p.at(3.0), 2.5);
+        assert_eq!(p.at(9.0), 2.0);
+        assert!(p.validate("v").is_ok());
+        let bad = VelocityProfile::Table {
+            s: vec![1.0, 1.0],
+            velocity: vec![1.0, 1.0],
+        };
+        assert_eq!(bad.validate("v").unwrap_err().field(), Some("v[1]"));
+    }
+
+    #[test]
+    fn flow_connors_formula_by_hand() {
+        // K = 3, f = 10 Hz, ζ = 0.01, m = 0.5 kg/m, ρ = 750 kg/m³, D = 0.019 m:
+        // δ = 0.0628318531, mδ/(ρD²) = 0.0314159265/0.27075 = 0.116032969,
+        // √ = 0.340636125, U_c = 3 · 10 · 0.019 · 0.340636125 = 0.194162591 m/s
+        let u = connors_critical_velocity(10.0, 0.01, 0.5, 750.0, 0.019, 3.0);
+        assert!((u - 0.194_162_591).abs() < 1e-8, "{u}");
+    }
+
+    #[test]
+    fn flow_gap_factor() {
+        let b = Bundle {
+            pattern: BundlePattern::RotatedSquare,
+            pitch_ratio: 1.5,
+        };
+        assert_eq!(b.gap_factor(), 3.0);
+    }
+}
