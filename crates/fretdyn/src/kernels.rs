@@ -22,6 +22,10 @@ pub(crate) trait Lanes: Copy {
     fn dot(a: &[f64], b: &[f64]) -> f64;
     /// `(a·b, a·c)` in one pass over `a`.
     fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64);
+    /// `out_r = A_r·x` for the rows `A_r` of the row-major matrix `a` (`x.len()` values per
+    /// row, `out.len()` rows), each summed exactly as [`Self::dot`] sums it: one pass over `x`
+    /// serves four rows.
+    fn dots(a: &[f64], x: &[f64], out: &mut [f64]);
     /// Writes `v_i = vs_i + h a_i` to `v` and returns `(½ Σ (v_i² + w2_i q_i²), Σ c_i v_i²,
     /// Σ f_i v_i)`: the velocity update of central differences with the structure's energy,
     /// its damping power and the power of the force `f` (slices of equal length).
@@ -87,6 +91,18 @@ impl Lanes for Portable {
     }
 
     #[inline(always)]
+    fn dots(a: &[f64], x: &[f64], out: &mut [f64]) {
+        let p = x.len();
+        if p == 0 {
+            out.fill(0.0);
+            return;
+        }
+        for (o, row) in out.iter_mut().zip(a.chunks_exact(p)) {
+            *o = Self::dot(row, x);
+        }
+    }
+
+    #[inline(always)]
     fn correct_with_energy(
         v: &mut [f64],
         vs: &[f64],
@@ -147,6 +163,12 @@ impl Lanes for Avx2 {
     fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
         // SAFETY: as above
         unsafe { avx2::dot2(a, b, c) }
+    }
+
+    #[inline(always)]
+    fn dots(a: &[f64], x: &[f64], out: &mut [f64]) {
+        // SAFETY: as above
+        unsafe { avx2::dots(a, x, out) }
     }
 
     #[inline(always)]
@@ -241,6 +263,59 @@ mod avx2 {
                 t[k] += a[full + k] * c[full + k];
             }
             (combine(s), combine(t))
+        }
+    }
+
+    /// [`super::Portable::dots`] on AVX2: four rows at a time share each load of `x`; every
+    /// row is summed as [`dot`] sums it.
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn dots(a: &[f64], x: &[f64], out: &mut [f64]) {
+        let p = x.len();
+        if p == 0 {
+            out.fill(0.0);
+            return;
+        }
+        let rows = out.len().min(a.len() / p);
+        let full = p - p % 4;
+        let mut r = 0;
+        // SAFETY: AVX2 (the caller's guarantee); row `r + j < rows` spans
+        // `a[(r + j) p..(r + j + 1) p]`, inside `a`, and every load reads `i..i + 4 ≤ full ≤ p`
+        unsafe {
+            while r + 4 <= rows {
+                let base = a.as_ptr().add(r * p);
+                let (mut s0, mut s1, mut s2, mut s3) = (
+                    _mm256_setzero_pd(),
+                    _mm256_setzero_pd(),
+                    _mm256_setzero_pd(),
+                    _mm256_setzero_pd(),
+                );
+                let mut i = 0;
+                while i < full {
+                    let y = _mm256_loadu_pd(x.as_ptr().add(i));
+                    s0 = _mm256_add_pd(s0, _mm256_mul_pd(_mm256_loadu_pd(base.add(i)), y));
+                    s1 = _mm256_add_pd(s1, _mm256_mul_pd(_mm256_loadu_pd(base.add(p + i)), y));
+                    s2 = _mm256_add_pd(s2, _mm256_mul_pd(_mm256_loadu_pd(base.add(2 * p + i)), y));
+                    s3 = _mm256_add_pd(s3, _mm256_mul_pd(_mm256_loadu_pd(base.add(3 * p + i)), y));
+                    i += 4;
+                }
+                for (j, acc) in [s0, s1, s2, s3].into_iter().enumerate() {
+                    let row = &a[(r + j) * p..(r + j + 1) * p];
+                    let mut s = lanes(acc);
+                    for k in 0..p - full {
+                        s[k] += row[full + k] * x[full + k];
+                    }
+                    out[r + j] = combine(s);
+                }
+                r += 4;
+            }
+            while r < rows {
+                out[r] = dot(&a[r * p..(r + 1) * p], x);
+                r += 1;
+            }
         }
     }
 
@@ -360,6 +435,18 @@ mod tests {
                 (x.0.to_bits(), x.1.to_bits()),
                 (y.0.to_bits(), y.1.to_bits())
             );
+            // 0–9 rows: the groups of four and the rows left over
+            for rows in 0..10 {
+                let m = values(rows * n, 7 * n as u64 + rows as u64);
+                let (mut o1, mut o2) = (vec![f64::NAN; rows], vec![f64::NAN; rows]);
+                Avx2::dots(&m, &a, &mut o1);
+                Portable::dots(&m, &a, &mut o2);
+                for r in 0..rows {
+                    let single = Portable::dot(&m[r * n..(r + 1) * n], &a);
+                    assert_eq!(o1[r].to_bits(), single.to_bits(), "{n} {rows} {r}");
+                    assert_eq!(o2[r].to_bits(), single.to_bits(), "{n} {rows} {r}");
+                }
+            }
             let (mut v1, mut v2) = (vec![0.0; n], vec![0.0; n]);
             let e1 = Avx2::correct_with_energy(&mut v1, &vs, &acc, 0.37, &q, &w2, &damping, &f);
             let e2 = Portable::correct_with_energy(&mut v2, &vs, &acc, 0.37, &q, &w2, &damping, &f);

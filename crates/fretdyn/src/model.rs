@@ -60,7 +60,7 @@ pub struct Model {
     pub turbulence: Vec<crate::loads::TurbulentLoad>,
     /// Uniform acceleration of the base, if any (displacements are then relative to it).
     pub base_acceleration: Option<BaseAcceleration>,
-    /// Fluid-elastic forces of the flow, on the modes (THEORY §11).
+    /// Fluid-elastic forces of the flow, on the modes (THEORY §13).
     pub fluid_elastic: Option<crate::loads::fluid_elastic::FluidElastic>,
     /// Initial state.
     pub initial: InitialState,

@@ -395,3 +395,146 @@ fn flow_bad_input_names_the_field() {
         );
     }
 }
+
+/// A zone's quasi-steady fluid-elastic forces projected on the tube's modes (THEORY §13): with
+/// the flow along z across a tube along x, the y modes see the lift terms and the z modes the
+/// drag terms. Per mode `C_ii / K_ii` is `D C_D / (U C_L')` (lift) and `2 D C_D / (U C_D')`
+/// (drag) exactly; the n = 1 pair has one shape, so its drag damping is twice its lift
+/// damping; the delay is `μ D / U`; a y mode and a z mode do not couple; and `∫φ² = 1/m` for
+/// a mass-normalised mode (up to the rotary inertia and the mesh: 1e-3).
+#[test]
+fn flow_quasi_steady_forces_project_on_the_modes() {
+    use fretdyn::loads::fluid_elastic::ModalMatrix;
+    let (u, rho, cl, cdp, cd, mu) = (2.0, 750.0, -3.0, 1.5, 0.8, 1.2);
+    let c = case(&pinned_tube(
+        0.02,
+        &format!(
+            "{FLOW_HEAD}\n[[flow.zones]]\nname = \"all\"\nspan = [0.0, {L}]\ndensity = {rho}\nvelocity = {u}\nfluid_elastic = {{ model = \"quasi_steady\", lift_slope = {cl}, drag_slope = {cdp}, drag = {cd}, mu = {mu}, flow_direction = [0.0, 0.0, 1.0] }}\n"
+        ),
+    ));
+    let fe = c
+        .model
+        .fluid_elastic
+        .as_ref()
+        .expect("fluid-elastic forces");
+    assert_eq!(fe.delayed.len(), 1);
+    assert!((fe.delayed[0].delay - mu * D / u).abs() <= 1e-15);
+    let p = c.model.basis.modes();
+    let (ModalMatrix::Dense(k), [ModalMatrix::Dense(cm)]) =
+        (&fe.delayed[0].stiffness, &fe.damping[..])
+    else {
+        panic!("dense matrices expected");
+    };
+    // the direction each mode moves in, from its largest component at point "a"
+    let a = &c.model.basis.points[c.model.basis.point_index("a").unwrap()];
+    let moves_y = |i: usize| a.rows[p + i].abs() > a.rows[2 * p + i].abs();
+    let m = {
+        let t = T;
+        let area = PI * (D * D - (D - 2.0 * t).powi(2)) / 4.0;
+        let inner = PI * (D - 2.0 * t).powi(2) / 4.0;
+        RHO_T * area + RHO_I * inner + CA * RHO_O * PI * D * D / 4.0
+    };
+    let mut lift_damping = None;
+    for i in 0..p {
+        let (kii, cii) = (k[i * p + i], cm[i * p + i]);
+        let expected = if moves_y(i) {
+            D * cd / (u * cl)
+        } else {
+            2.0 * D * cd / (u * cdp)
+        };
+        assert!((cii / kii / expected - 1.0).abs() < 1e-12, "mode {i}");
+        // ∫φ² from the damping: C = ρUD C_D (½ or 1) ∫φ²
+        let share = if moves_y(i) { 0.5 } else { 1.0 };
+        let integral = cii / (rho * u * D * cd * share);
+        assert!(
+            (integral * m - 1.0).abs() < 1e-3,
+            "mode {i}: ∫φ² m = {}",
+            integral * m
+        );
+        if ORDER[i] == 1.0 {
+            if moves_y(i) {
+                lift_damping = Some(cii);
+            } else if let Some(l) = lift_damping {
+                assert!((cii / l - 2.0).abs() < 1e-9, "{cii} {l}");
+            }
+        }
+        for j in 0..p {
+            if moves_y(i) != moves_y(j) {
+                assert!(k[i * p + j].abs() <= 1e-12 * kii.abs());
+                assert!(cm[i * p + j].abs() <= 1e-12 * cii.abs());
+            }
+        }
+    }
+}
+
+#[test]
+fn flow_fluid_elastic_bad_input_names_the_field() {
+    let zone = |fe: &str| {
+        pinned_tube(
+            0.05,
+            &format!(
+                "{FLOW_HEAD}\n[[flow.zones]]\nname = \"all\"\nspan = [0.0, {L}]\ndensity = 750.0\nvelocity = 2.0\nfluid_elastic = {fe}\n"
+            ),
+        )
+    };
+    for (fe, field) in [
+        (
+            "{ model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu = -1.0, flow_direction = [0.0, 0.0, 1.0] }",
+            "flow.zones[0].fluid_elastic.mu",
+        ),
+        (
+            "{ model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu = 1.0, flow_direction = [2.0, 0.0, 0.0] }",
+            "flow.zones[0].fluid_elastic.flow_direction",
+        ),
+        (
+            "{ model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu = 1.0, flow_direction = [0.0, 0.0, 0.0] }",
+            "flow.zones[0].fluid_elastic.flow_direction",
+        ),
+        (
+            "{ model = \"table\", reduced_velocity = [1.0, 1.0], damping = [0.0, 0.0], stiffness = [0.0, 0.0] }",
+            "flow.zones[0].fluid_elastic.reduced_velocity[1]",
+        ),
+        (
+            "{ model = \"table\", reduced_velocity = [1.0, 2.0], damping = [0.0], stiffness = [0.0, 0.0] }",
+            "flow.zones[0].fluid_elastic",
+        ),
+    ] {
+        assert_eq!(error_field(&zone(fe)), field, "{fe}");
+    }
+}
+
+/// A velocity profile: `U(s) = 1 + 2 s/L` over the whole pinned tube gives
+/// `U_eff² = ∫ U² sin²(nπs/L) ds / (L/2)`, integrated here by composite Simpson on 4 000
+/// intervals (independent of the stations' Gauss quadrature on the elements); the elements'
+/// shapes differ from the sines by their discretisation error (below 1e-9 on this mesh, see
+/// the partial-span test).
+#[test]
+fn flow_velocity_profile_matches_a_numerical_quadrature() {
+    let c = case(&pinned_tube(
+        0.025,
+        &format!(
+            "{FLOW_HEAD}\n[[flow.zones]]\nname = \"all\"\nspan = [0.0, {L}]\ndensity = 750.0\nvelocity_profile = [[0.0, 1.0], [{L}, 3.0]]\n"
+        ),
+    ));
+    let r = c.stability().unwrap();
+    let simpson = |f: &dyn Fn(f64) -> f64| {
+        let n = 4000;
+        let h = L / n as f64;
+        let mut s = f(0.0) + f(L);
+        for i in 1..n {
+            s += if i % 2 == 1 { 4.0 } else { 2.0 } * f(i as f64 * h);
+        }
+        s * h / 3.0
+    };
+    for (m, order) in r.modes.iter().zip(ORDER) {
+        let w = order * PI / L;
+        let num = simpson(&|s: f64| (1.0 + 2.0 * s / L).powi(2) * (w * s).sin().powi(2));
+        let expected = (num / (0.5 * L)).sqrt();
+        assert!(
+            (m.effective_velocity / expected - 1.0).abs() < 1e-8,
+            "mode {}: {} against {expected}",
+            m.mode,
+            m.effective_velocity
+        );
+    }
+}

@@ -44,9 +44,35 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-fn allocations_of_run(method: TangentialMethod, steps: u64, turbulence: bool) -> (usize, u64) {
+fn allocations_of_run(
+    method: TangentialMethod,
+    steps: u64,
+    (turbulence, fluid): (bool, bool),
+) -> (usize, u64) {
     let mut case = rattling_tube(10, 4, method, steps);
     case.settings.output_every = 100;
+    if fluid {
+        // a delayed fluid stiffness (37.3 steps: the ring buffer wraps many times) and a
+        // dense and a diagonal one without delay, a fluid damping
+        use fretdyn::loads::fluid_elastic::{DelayedStiffness, FluidElastic, ModalMatrix};
+        let p = case.model.basis.modes();
+        let small = |k: usize| ((k % 5) as f64 - 2.0) * 0.5;
+        case.model.fluid_elastic = Some(FluidElastic {
+            delayed: vec![
+                DelayedStiffness {
+                    name: "a".into(),
+                    delay: 37.3 * case.settings.dt,
+                    stiffness: ModalMatrix::Dense((0..p * p).map(small).collect()),
+                },
+                DelayedStiffness {
+                    name: "b".into(),
+                    delay: 0.0,
+                    stiffness: ModalMatrix::Diagonal((0..p).map(small).collect()),
+                },
+            ],
+            damping: vec![ModalMatrix::Dense((0..p * p).map(small).collect())],
+        });
+    }
     if turbulence {
         // 3 random channels on the modes, sampled at 80 kHz: 20 000 steps cross several
         // blocks of the generator
@@ -90,9 +116,9 @@ fn the_step_loop_does_not_allocate() {
         TangentialMethod::ActiveSet(ActiveSetSettings::default()),
         TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
     ] {
-        for turbulence in [false, true] {
-            let (short, _) = allocations_of_run(method, 2_000, turbulence);
-            let (long, contact_steps) = allocations_of_run(method, 20_000, turbulence);
+        for (turbulence, fluid) in [(false, false), (true, false), (false, true)] {
+            let (short, _) = allocations_of_run(method, 2_000, (turbulence, fluid));
+            let (long, contact_steps) = allocations_of_run(method, 20_000, (turbulence, fluid));
             assert!(
                 method.is_lagrange() == (contact_steps > 1000),
                 "{}: the run must exercise the contact solver ({contact_steps} steps)",
@@ -102,7 +128,7 @@ fn the_step_loop_does_not_allocate() {
             assert_eq!(
                 short,
                 long,
-                "{} (turbulence {turbulence}): {short} allocations for 2 000 steps, {long} for 20 000",
+                "{} (turbulence {turbulence}, fluid-elastic {fluid}): {short} allocations for 2 000 steps, {long} for 20 000",
                 method.name()
             );
         }

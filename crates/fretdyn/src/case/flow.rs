@@ -2,14 +2,17 @@
 //! zone a stretch of the tube, a density and a velocity), sampled on the mode shapes for the
 //! Connors check and the loads that use the zones (docs/FLOW.md).
 
+use nalgebra::Vector3;
 use serde::Deserialize;
 
 use super::{TubeModel, point_index};
 use crate::error::{Error, Result, number};
+use crate::loads::flow::ZoneFluidElastic;
 use crate::loads::flow::{
     Bundle, BundlePattern, Flow, FlowZone, Station, VelocityDefinition, VelocityProfile,
     midpoint_weights,
 };
+use crate::loads::fluid_elastic::{QuasiSteady, ReducedVelocityTable};
 use crate::model::Model;
 
 /// `[flow]`.
@@ -49,6 +52,148 @@ struct ZoneSection {
     velocity: Option<f64>,
     /// `[[s, U], ...]`.
     velocity_profile: Option<Vec<[f64; 2]>>,
+    /// The zone's fluid-elastic forces (THEORY §13).
+    fluid_elastic: Option<FluidElasticInput>,
+}
+
+/// `fluid_elastic = { model = "quasi_steady", ... }` or `{ model = "table", ... }` of a zone.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
+enum FluidElasticInput {
+    QuasiSteady {
+        lift_slope: f64,
+        #[serde(default)]
+        drag_slope: f64,
+        drag: f64,
+        mu: f64,
+        flow_direction: [f64; 3],
+        #[serde(default = "default_delay_segments")]
+        delay_segments: usize,
+    },
+    Table {
+        reduced_velocity: Vec<f64>,
+        damping: Vec<f64>,
+        stiffness: Vec<f64>,
+    },
+}
+
+fn default_delay_segments() -> usize {
+    4
+}
+
+impl FluidElasticInput {
+    fn build(
+        &self,
+        field: &str,
+        stations: &[crate::loads::flow::Station],
+    ) -> Result<ZoneFluidElastic> {
+        let finite = |v: f64, key: &str| {
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(Error::invalid(
+                    format!("{field}.{key}"),
+                    format!("must be a finite number (got {})", number(v)),
+                ))
+            }
+        };
+        match self {
+            FluidElasticInput::QuasiSteady {
+                lift_slope,
+                drag_slope,
+                drag,
+                mu,
+                flow_direction,
+                delay_segments,
+            } => {
+                finite(*lift_slope, "lift_slope")?;
+                finite(*drag_slope, "drag_slope")?;
+                finite(*drag, "drag")?;
+                if !(mu.is_finite() && *mu >= 0.0) {
+                    return Err(Error::invalid(
+                        format!("{field}.mu"),
+                        format!(
+                            "must be a number ≥ 0, the time-lag factor of τ = μ D / U (got {})",
+                            number(*mu)
+                        ),
+                    ));
+                }
+                if *delay_segments == 0 {
+                    return Err(Error::invalid(
+                        format!("{field}.delay_segments"),
+                        "must be at least 1",
+                    ));
+                }
+                let d = Vector3::from(*flow_direction);
+                if !(d.iter().all(|v| v.is_finite()) && d.norm() > 0.0) {
+                    return Err(Error::invalid(
+                        format!("{field}.flow_direction"),
+                        "must be a nonzero finite vector [x, y, z], the direction of the cross flow",
+                    ));
+                }
+                let d = d.normalize();
+                if let Some(st) = stations
+                    .iter()
+                    .find(|st| (d - st.tangent * d.dot(&st.tangent)).norm() < 1e-6)
+                {
+                    return Err(Error::invalid(
+                        format!("{field}.flow_direction"),
+                        format!(
+                            "is along the tube's axis at s = {} m: a cross flow must cross the tube",
+                            number(st.s)
+                        ),
+                    ));
+                }
+                Ok(ZoneFluidElastic::QuasiSteady {
+                    coefficients: QuasiSteady {
+                        lift_slope: *lift_slope,
+                        drag_slope: *drag_slope,
+                        drag: *drag,
+                        mu: *mu,
+                    },
+                    flow_direction: d,
+                    delay_segments: *delay_segments,
+                })
+            }
+            FluidElasticInput::Table {
+                reduced_velocity,
+                damping,
+                stiffness,
+            } => {
+                let n = reduced_velocity.len();
+                if n == 0 || damping.len() != n || stiffness.len() != n {
+                    return Err(Error::invalid(
+                        field,
+                        format!(
+                            "reduced_velocity, damping and stiffness must have the same number (≥ 1) of values (got {n}, {}, {})",
+                            damping.len(),
+                            stiffness.len()
+                        ),
+                    ));
+                }
+                for (key, v) in [
+                    ("reduced_velocity", reduced_velocity),
+                    ("damping", damping),
+                    ("stiffness", stiffness),
+                ] {
+                    for (i, x) in v.iter().enumerate() {
+                        finite(*x, &format!("{key}[{i}]"))?;
+                    }
+                }
+                if let Some(i) = reduced_velocity.windows(2).position(|w| w[1] <= w[0]) {
+                    return Err(Error::invalid(
+                        format!("{field}.reduced_velocity[{}]", i + 1),
+                        "the reduced velocities must increase",
+                    ));
+                }
+                Ok(ZoneFluidElastic::Table(ReducedVelocityTable {
+                    reduced_velocity: reduced_velocity.clone(),
+                    damping: damping.clone(),
+                    stiffness: stiffness.clone(),
+                }))
+            }
+        }
+    }
 }
 
 /// Where the points of a structure are along the tube, for zones given by points on a
@@ -379,12 +524,17 @@ impl ZoneSection {
                 ));
             }
         }
+        let fluid_elastic = match &self.fluid_elastic {
+            Some(f) => Some(f.build(&format!("{field}.fluid_elastic"), &stations)?),
+            None => None,
+        };
         Ok(FlowZone {
             name: self.name.clone(),
             span: [s0, s1],
             density,
             velocity,
             stations,
+            fluid_elastic,
         })
     }
 

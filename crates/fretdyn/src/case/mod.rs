@@ -200,6 +200,15 @@ impl CaseFile {
             None => None,
         };
         self.build_loads(base, tube.as_deref(), flow.as_deref(), &mut model)?;
+        if let Some(f) = &flow {
+            let hz: Vec<f64> = model
+                .basis
+                .omega
+                .iter()
+                .map(|w| w / std::f64::consts::TAU)
+                .collect();
+            model.fluid_elastic = f.fluid_elastic(&hz);
+        }
         self.build_initial(&mut model)?;
         model.validate()?;
         let settings = self.settings(&model)?;

@@ -123,7 +123,7 @@ pub fn checked_stable_time_step(model: &Model, method: &TangentialMethod) -> Res
         ));
     };
     // the fluid-elastic forces are explicit: their stiffness and damping bounds are added
-    // (conservative: the delayed stiffness as if it acted at once, THEORY §11)
+    // (conservative: the delayed stiffness as if it acted at once, THEORY §13)
     let (w2, cmax) = match &model.fluid_elastic {
         Some(fe) => (w2 + fe.stiffness_bound(p), cmax + fe.damping_bound(p)),
         None => (w2, cmax),

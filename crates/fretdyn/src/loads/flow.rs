@@ -23,6 +23,8 @@
 //! (uniform) mass per unit length of the tube with its internal fluid and hydrodynamic mass.
 
 use nalgebra::Vector3;
+
+use crate::loads::fluid_elastic::{FlowNode, FluidElastic, QuasiSteady, ReducedVelocityTable};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, number};
@@ -221,6 +223,23 @@ pub fn midpoint_weights(s: &[f64], a: f64, b: f64) -> Vec<f64> {
         .collect()
 }
 
+/// The fluid-elastic force model of a zone (THEORY §13, docs/FLOW.md).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ZoneFluidElastic {
+    /// The quasi-steady model with a time lag.
+    QuasiSteady {
+        /// `C_L'`, `C_D'`, `C_D`, `μ`.
+        coefficients: QuasiSteady,
+        /// Direction of the flow (drag); the lift is across it and the tube's axis.
+        flow_direction: Vector3<f64>,
+        /// A velocity profile's zone is cut into this many equal stretches, each with the delay
+        /// `μ D / U` of the velocity at its middle (the force itself uses the local `U`).
+        delay_segments: usize,
+    },
+    /// Tabulated modal damping and stiffness per unit length against the reduced velocity.
+    Table(ReducedVelocityTable),
+}
+
 /// A stretch of the tube in a uniform-density cross flow.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlowZone {
@@ -234,6 +253,8 @@ pub struct FlowZone {
     pub velocity: VelocityProfile,
     /// Quadrature stations over the span with the mode shapes.
     pub stations: Vec<Station>,
+    /// Its fluid-elastic forces, if any.
+    pub fluid_elastic: Option<ZoneFluidElastic>,
 }
 
 impl FlowZone {
@@ -415,9 +436,120 @@ impl Flow {
     }
 
     /// The zone named `name`.
+    /// The fluid-elastic forces of the zones that have them, projected on the modes of
+    /// frequencies `frequencies_hz` (THEORY §13): `None` when no zone has any.
+    pub fn fluid_elastic(&self, frequencies_hz: &[f64]) -> Option<FluidElastic> {
+        let p = frequencies_hz.len();
+        let mut total: Option<FluidElastic> = None;
+        for zone in &self.zones {
+            let Some(model) = &zone.fluid_elastic else {
+                continue;
+            };
+            let name = format!("flow.zones.{}", zone.name);
+            let (s0, s1) = (zone.span[0], zone.span[1]);
+            let segments = match model {
+                ZoneFluidElastic::QuasiSteady { delay_segments, .. }
+                    if zone.velocity.constant().is_none() =>
+                {
+                    (*delay_segments).max(1)
+                }
+                _ => 1,
+            };
+            let (mu, direction) = match model {
+                ZoneFluidElastic::QuasiSteady {
+                    coefficients,
+                    flow_direction,
+                    ..
+                } => (coefficients.mu, *flow_direction),
+                ZoneFluidElastic::Table(_) => (0.0, Vector3::zeros()),
+            };
+            let nodes: Vec<FlowNode> = zone
+                .stations
+                .iter()
+                .map(|st| {
+                    let u = zone.velocity.at(st.s);
+                    let k = (((st.s - s0) / (s1 - s0)) * segments as f64).floor() as usize;
+                    let k = k.min(segments - 1);
+                    let mid = s0 + (k as f64 + 0.5) * (s1 - s0) / segments as f64;
+                    let u_delay = if segments == 1 {
+                        zone.velocity.constant().unwrap_or(u)
+                    } else {
+                        zone.velocity.at(mid)
+                    };
+                    let (lift, drag) = cross_flow_axes(&st.tangent, &direction);
+                    FlowNode {
+                        weight: st.weight,
+                        density: zone.density,
+                        velocity: u,
+                        delay: if u_delay > 0.0 {
+                            mu * self.diameter / u_delay
+                        } else {
+                            0.0
+                        },
+                        diameter: self.diameter,
+                        lift,
+                        drag,
+                        rows: &st.rows,
+                    }
+                })
+                .collect();
+            let fe = match model {
+                ZoneFluidElastic::QuasiSteady { coefficients, .. } => {
+                    FluidElastic::quasi_steady(&name, coefficients, &nodes, p)
+                }
+                ZoneFluidElastic::Table(table) => {
+                    FluidElastic::tabulated(&name, table, &nodes, frequencies_hz)
+                }
+            };
+            match &mut total {
+                Some(t) => t.merge(fe),
+                None => total = Some(fe),
+            }
+        }
+        total
+    }
+
     pub fn zone(&self, name: &str) -> Option<&FlowZone> {
         self.zones.iter().find(|z| z.name == name)
     }
+}
+
+/// The lift and drag directions at a station of axis `tangent` for the flow `direction`:
+/// drag = the flow's direction made normal to the axis, lift = axis × drag. For the tabulated
+/// model (`direction` zero), any two unit vectors normal to the axis and to each other (its
+/// coefficients act on the whole transverse displacement).
+fn cross_flow_axes(
+    tangent: &Vector3<f64>,
+    direction: &Vector3<f64>,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let t = if tangent.norm() > 0.0 {
+        tangent.normalize()
+    } else {
+        Vector3::zeros()
+    };
+    let d = if direction.norm() > 0.0 {
+        *direction
+    } else {
+        // a vector not along the axis
+        if t.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        }
+    };
+    let drag = (d - t * d.dot(&t)).normalize();
+    let lift = if t.norm() > 0.0 {
+        t.cross(&drag)
+    } else {
+        // no axis known: the lift is any unit vector normal to the drag
+        let e = if drag.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        };
+        (e - drag * e.dot(&drag)).normalize()
+    };
+    (lift, drag)
 }
 
 #[cfg(test)]

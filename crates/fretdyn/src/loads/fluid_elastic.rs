@@ -1,4 +1,4 @@
-//! Fluid-elastic forces on the modes (THEORY §11): the force the flow exerts because the tube
+//! Fluid-elastic forces on the modes (THEORY §13): the force the flow exerts because the tube
 //! moves, projected on the modes once before the run,
 //!
 //! ```text
@@ -30,6 +30,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::kernels::Lanes;
 
 /// A modal matrix (`p × p`, row-major) or its diagonal.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,18 +42,15 @@ pub enum ModalMatrix {
 }
 
 impl ModalMatrix {
-    /// `out += s · M x` (`p = x.len()`).
-    #[inline]
-    fn mul_add(&self, s: f64, x: &[f64], out: &mut [f64]) {
-        let p = x.len();
+    /// `out += s · M x` (`p = x.len()`; `work` holds p values), the rows' products summed by
+    /// the kernels `K` ([`crate::kernels::Lanes::dots`]).
+    #[inline(always)]
+    fn mul_add<K: Lanes>(&self, s: f64, x: &[f64], work: &mut [f64], out: &mut [f64]) {
         match self {
             ModalMatrix::Dense(m) => {
-                for (o, row) in out.iter_mut().zip(m.chunks_exact(p.max(1))) {
-                    let mut acc = 0.0;
-                    for (a, b) in row.iter().zip(x) {
-                        acc += a * b;
-                    }
-                    *o += s * acc;
+                K::dots(m, x, work);
+                for (o, w) in out.iter_mut().zip(work.iter()) {
+                    *o += s * w;
                 }
             }
             ModalMatrix::Diagonal(d) => {
@@ -176,7 +174,7 @@ impl FluidElastic {
     }
 
     /// A bound of the fluid stiffness's eigenvalues, 1/s², added to `ω_max²` for the stable
-    /// time step (THEORY §11).
+    /// time step (THEORY §13).
     pub fn stiffness_bound(&self, p: usize) -> f64 {
         self.delayed
             .iter()
@@ -211,10 +209,11 @@ impl FluidElastic {
         }
     }
 
-    /// The quasi-steady model with a time lag (Price & Païdoussis; THEORY §11) on the flow
+    /// The quasi-steady model with a time lag (Price & Païdoussis; THEORY §13) on the flow
     /// `nodes` of one zone: per unit length `f_lift = ½ρU² C_L' y(t − τ) − ½ρUD C_D ẏ`,
-    /// `f_drag = ½ρU² C_D' x(t − τ) − ρUD C_D ẋ`, `τ = μ D / U`, integrated with the nodes'
-    /// weights (one delay group per distinct delay of the nodes). `name` names the zone.
+    /// `f_drag = ½ρU² C_D' x(t − τ) − ρUD C_D ẋ`, integrated with the nodes' weights, each
+    /// node with its delay [`FlowNode::delay`] (`μ D / U`; one delay group per distinct
+    /// delay). `name` names the zone.
     pub fn quasi_steady(
         name: &str,
         coefficients: &QuasiSteady,
@@ -230,11 +229,7 @@ impl FluidElastic {
         for n in nodes {
             n.directional_rows(&mut lift, &mut drag);
             let q = 0.5 * n.density * n.velocity * n.velocity * n.weight;
-            let delay = if n.velocity > 0.0 {
-                coefficients.mu * n.diameter / n.velocity
-            } else {
-                0.0
-            };
+            let delay = n.delay;
             let mut k = vec![0.0; p * p];
             add_outer(&mut k, q * coefficients.lift_slope, &lift);
             add_outer(&mut k, q * coefficients.drag_slope, &drag);
@@ -254,7 +249,7 @@ impl FluidElastic {
         out
     }
 
-    /// Tabulated modal coefficients (the form of Code_Aster and EDF; THEORY §11): per mode
+    /// Tabulated modal coefficients (the form of Code_Aster and EDF; THEORY §13): per mode
     /// `i` of frequency `f_i`, at each node the reduced velocity `V_r = U / (f_i D)` gives a
     /// damping `c(V_r)` (N·s/m²) and a stiffness `k(V_r)` (N/m²) per unit length, acting on
     /// the displacement across the tube in both directions of the flow's plane:
@@ -304,7 +299,7 @@ fn add_outer(m: &mut [f64], s: f64, x: &[f64]) {
     }
 }
 
-/// Coefficients of the quasi-steady model (THEORY §11; published values in docs/FLOW.md).
+/// Coefficients of the quasi-steady model (THEORY §13; published values in docs/FLOW.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct QuasiSteady {
     /// `C_L' = ∂C_L/∂(y/D)`, lift derivative across the flow.
@@ -358,8 +353,11 @@ pub struct FlowNode<'a> {
     pub weight: f64,
     /// Fluid density `ρ`, kg/m³.
     pub density: f64,
-    /// Flow velocity `U` (pitch or gap, as the zone defines it), m/s.
+    /// Flow velocity `U` (the gap velocity), m/s.
     pub velocity: f64,
+    /// Delay `τ` of the quasi-steady model, s (`μ D / U` with the node's `U`, or with its
+    /// stretch's mean velocity; ignored by the tabulated model).
+    pub delay: f64,
     /// Tube outer diameter `D`, m.
     pub diameter: f64,
     /// Unit direction across the flow (lift).
@@ -395,6 +393,8 @@ pub struct FluidElasticForce {
     work: Vec<f64>,
     /// The velocity of the damping term.
     velocity: Vec<f64>,
+    /// A matrix's product.
+    product: Vec<f64>,
     /// The force of the step (kept for its power).
     pub force: Vec<f64>,
 }
@@ -432,6 +432,7 @@ impl FluidElasticForce {
             slots,
             work: vec![0.0; p],
             velocity: vec![0.0; p],
+            product: vec![0.0; p],
             force: vec![0.0; p],
         }
     }
@@ -452,8 +453,8 @@ impl FluidElasticForce {
     /// The force at step `n` (whose displacement [`Self::record`] stored) with the velocity
     /// `q̇ + h q̈` of the previous step's velocity and acceleration (`h = Δt`; `h = 0` at the
     /// start, where `q̇` is the initial velocity): written to [`Self::force`] and added to `out`.
-    #[inline]
-    pub fn apply(
+    #[inline(always)]
+    pub(crate) fn apply<K: Lanes>(
         &mut self,
         fe: &FluidElastic,
         n: u64,
@@ -474,14 +475,15 @@ impl FluidElasticForce {
             for ((w, x), y) in self.work.iter_mut().zip(&self.ring[ra]).zip(&self.ring[rb]) {
                 *w = (1.0 - theta) * x + theta * y;
             }
-            g.stiffness.mul_add(1.0, &self.work, &mut self.force);
+            g.stiffness
+                .mul_add::<K>(1.0, &self.work, &mut self.product, &mut self.force);
         }
         if !fe.damping.is_empty() {
             for ((v, x), a) in self.velocity.iter_mut().zip(qd).zip(qdd) {
                 *v = x + h * a;
             }
             for c in &fe.damping {
-                c.mul_add(-1.0, &self.velocity, &mut self.force);
+                c.mul_add::<K>(-1.0, &self.velocity, &mut self.product, &mut self.force);
             }
         }
         for (o, f) in out.iter_mut().zip(&self.force) {

@@ -24,7 +24,7 @@ pub struct EnergyBalance {
     /// energy momentarily stored in tangential penalty springs).
     pub tangential: f64,
     /// Work of the fluid-elastic forces on the structure, J: the energy the flow feeds in
-    /// (negative when the flow damps the motion; THEORY §11). Not part of `external_work`.
+    /// (negative when the flow damps the motion; THEORY §13). Not part of `external_work`.
     pub fluid_work: f64,
     /// Largest `|E − E(0) − W_ext − W_fe + D|` over the run divided by the largest energy
     /// scale `max(E, E(0) + |W_ext| + |W_fe|)` seen.

@@ -50,17 +50,17 @@ impl Simulation<'_> {
         }
     }
 
-    /// The fluid-elastic force of step `n` added to the external force (THEORY §11): the
+    /// The fluid-elastic force of step `n` added to the external force (THEORY §13): the
     /// displacement of the step is stored for the delays; the velocity is extrapolated from
     /// the previous step's (`started`), or is the initial one.
     #[inline(always)]
-    pub(super) fn fluid_elastic_force(&mut self, n: u64, started: bool) {
+    pub(super) fn fluid_elastic_force<K: Lanes>(&mut self, n: u64, started: bool) {
         let (Some(fluid), Some(fe)) = (&mut self.fluid, &self.model.fluid_elastic) else {
             return;
         };
         fluid.record(n, &self.cd.q);
         let h = if started { self.settings.dt } else { 0.0 };
-        fluid.apply(fe, n, (&self.cd.qd, &self.cd.qdd, h), &mut self.external);
+        fluid.apply::<K>(fe, n, (&self.cd.qd, &self.cd.qdd, h), &mut self.external);
     }
 
     /// Step 3: penetrations, frames, velocities (predicted when `predicted`) and normal

@@ -550,7 +550,7 @@ impl<'m> Simulation<'m> {
     /// t = 0: contacts at the initial state, initial acceleration, first sample.
     fn start(&mut self) {
         self.external_force(0.0);
-        self.fluid_elastic_force(0, false);
+        self.fluid_elastic_force::<Portable>(0, false);
         self.detect::<Portable>(0.0, false);
         self.contact_forces();
         self.cd.start(&self.force);
@@ -625,7 +625,9 @@ impl<'m> Simulation<'m> {
         let t = self.step as f64 * self.settings.dt;
         self.cd.predict();
         self.external_force(t);
-        self.fluid_elastic_force(self.step, true);
+        if self.fluid.is_some() {
+            self.fluid_elastic_force::<K>(self.step, true);
+        }
         self.detect::<K>(t, true);
         self.contact_forces();
         self.cd.free_acceleration(&self.force);
