@@ -5,8 +5,9 @@
 //! per run, [`crate::integrator::simulation::Simulation::step`]).
 //!
 //! Both sum in four lanes: lane `k` accumulates the terms `i ≡ k (mod 4)` of the whole chunks
-//! of four, in order; the remaining `r < 4` terms are then added to lanes `0..r`; the result is
-//! `(s₀ + s₁) + (s₂ + s₃)`. Each lane does the same multiplications and additions in the same
+//! of four, in order; the remaining `r < 4` terms are then added to lanes `0..r` and, when
+//! `r > 0`, `+0` to the others (one masked vector operation: it changes a lane's `−0` into
+//! `+0`, nothing else); the result is `(s₀ + s₁) + (s₂ + s₃)`. Each lane does the same multiplications and additions in the same
 //! order in both implementations (no fused multiply-add), so they agree bit for bit
 //! (tested below and in `tests/vector_width.rs`). The compiler does not turn such four-lane
 //! sums into clean vector code by itself, hence the intrinsics.
@@ -51,6 +52,18 @@ fn combine(s: [f64; 4]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3])
 }
 
+/// The masked tail's `+0` on the lanes `r..4` of each sum, when `r > 0` (module documentation).
+#[inline(always)]
+fn masked_zeros(sums: &mut [&mut [f64; 4]], r: usize) {
+    if r > 0 {
+        for s in sums.iter_mut() {
+            for lane in s[r..].iter_mut() {
+                *lane += 0.0;
+            }
+        }
+    }
+}
+
 impl Lanes for Portable {
     #[inline(always)]
     fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -67,6 +80,7 @@ impl Lanes for Portable {
         for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
             s[k] += x * y;
         }
+        masked_zeros(&mut [&mut s], ra.len());
         combine(s)
     }
 
@@ -87,6 +101,7 @@ impl Lanes for Portable {
             s[k] += x * y;
             t[k] += x * z;
         }
+        masked_zeros(&mut [&mut s, &mut t], ra.len());
         (combine(s), combine(t))
     }
 
@@ -143,6 +158,7 @@ pub(crate) fn energy_sums(
         d[k] += c[i] * x * x;
         w[k] += f[i] * x;
     }
+    masked_zeros(&mut [&mut e, &mut d, &mut w], p - full);
     (0.5 * combine(e), combine(d), combine(w))
 }
 
@@ -193,11 +209,31 @@ impl Lanes for Avx2 {
 #[allow(unused_unsafe)]
 mod avx2 {
     use std::arch::x86_64::{
-        __m256d, _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd,
-        _mm256_storeu_pd,
+        __m256d, __m256i, _mm256_add_pd, _mm256_loadu_pd, _mm256_loadu_si256, _mm256_maskload_pd,
+        _mm256_maskstore_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
     };
 
     use super::combine;
+
+    /// `MASKS[r]`: the first `r` lanes.
+    static MASKS: [[i64; 4]; 4] = [[0, 0, 0, 0], [-1, 0, 0, 0], [-1, -1, 0, 0], [-1, -1, -1, 0]];
+
+    /// The mask of the first `r < 4` lanes.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn first(r: usize) -> __m256i {
+        // SAFETY: MASKS[r & 3] holds 4 values
+        unsafe { _mm256_loadu_si256(MASKS[r & 3].as_ptr().cast()) }
+    }
+
+    /// The `r < 4` values at `p` (the lanes after them 0): a masked load, which reads (and
+    /// may fault on) the `r` values only.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn tail(p: *const f64, mask: __m256i) -> __m256d {
+        // SAFETY: the caller's `p..p + r` is inside a slice; the masked lanes are not read
+        unsafe { _mm256_maskload_pd(p, mask) }
+    }
 
     /// The four lanes of `x`.
     #[inline]
@@ -218,21 +254,41 @@ mod avx2 {
     pub(super) unsafe fn dot(a: &[f64], b: &[f64]) -> f64 {
         let n = a.len().min(b.len());
         let full = n - n % 4;
-        // SAFETY: AVX2 (the caller's guarantee); every load reads i..i + 4 ≤ full ≤ n
+        // SAFETY: AVX2 (the caller's guarantee); every load reads i..i + 4 ≤ full ≤ n, the
+        // tail's masked loads full..n
         unsafe {
+            let (pa, pb) = (a.as_ptr(), b.as_ptr());
             let mut acc = _mm256_setzero_pd();
             let mut i = 0;
-            while i < full {
-                let x = _mm256_loadu_pd(a.as_ptr().add(i));
-                let y = _mm256_loadu_pd(b.as_ptr().add(i));
-                acc = _mm256_add_pd(acc, _mm256_mul_pd(x, y));
-                i += 4;
+            // two chunks per turn, added in order: the same sums as one per turn
+            while i + 8 <= full {
+                acc = _mm256_add_pd(
+                    acc,
+                    _mm256_mul_pd(_mm256_loadu_pd(pa.add(i)), _mm256_loadu_pd(pb.add(i))),
+                );
+                acc = _mm256_add_pd(
+                    acc,
+                    _mm256_mul_pd(
+                        _mm256_loadu_pd(pa.add(i + 4)),
+                        _mm256_loadu_pd(pb.add(i + 4)),
+                    ),
+                );
+                i += 8;
             }
-            let mut s = lanes(acc);
-            for k in 0..n - full {
-                s[k] += a[full + k] * b[full + k];
+            if i < full {
+                acc = _mm256_add_pd(
+                    acc,
+                    _mm256_mul_pd(_mm256_loadu_pd(pa.add(i)), _mm256_loadu_pd(pb.add(i))),
+                );
             }
-            combine(s)
+            if n > full {
+                let m = first(n - full);
+                acc = _mm256_add_pd(
+                    acc,
+                    _mm256_mul_pd(tail(pa.add(full), m), tail(pb.add(full), m)),
+                );
+            }
+            combine(lanes(acc))
         }
     }
 
@@ -245,24 +301,25 @@ mod avx2 {
     pub(super) unsafe fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
         let n = a.len().min(b.len()).min(c.len());
         let full = n - n % 4;
-        // SAFETY: AVX2 (the caller's guarantee); every load reads i..i + 4 ≤ full ≤ n
+        // SAFETY: AVX2 (the caller's guarantee); every load reads i..i + 4 ≤ full ≤ n, the
+        // tail's masked loads full..n
         unsafe {
+            let (pa, pb, pc) = (a.as_ptr(), b.as_ptr(), c.as_ptr());
             let (mut s, mut t) = (_mm256_setzero_pd(), _mm256_setzero_pd());
             let mut i = 0;
             while i < full {
-                let x = _mm256_loadu_pd(a.as_ptr().add(i));
-                let y = _mm256_loadu_pd(b.as_ptr().add(i));
-                let z = _mm256_loadu_pd(c.as_ptr().add(i));
-                s = _mm256_add_pd(s, _mm256_mul_pd(x, y));
-                t = _mm256_add_pd(t, _mm256_mul_pd(x, z));
+                let x = _mm256_loadu_pd(pa.add(i));
+                s = _mm256_add_pd(s, _mm256_mul_pd(x, _mm256_loadu_pd(pb.add(i))));
+                t = _mm256_add_pd(t, _mm256_mul_pd(x, _mm256_loadu_pd(pc.add(i))));
                 i += 4;
             }
-            let (mut s, mut t) = (lanes(s), lanes(t));
-            for k in 0..n - full {
-                s[k] += a[full + k] * b[full + k];
-                t[k] += a[full + k] * c[full + k];
+            if n > full {
+                let m = first(n - full);
+                let x = tail(pa.add(full), m);
+                s = _mm256_add_pd(s, _mm256_mul_pd(x, tail(pb.add(full), m)));
+                t = _mm256_add_pd(t, _mm256_mul_pd(x, tail(pc.add(full), m)));
             }
-            (combine(s), combine(t))
+            (combine(lanes(s)), combine(lanes(t)))
         }
     }
 
@@ -302,13 +359,16 @@ mod avx2 {
                     s3 = _mm256_add_pd(s3, _mm256_mul_pd(_mm256_loadu_pd(base.add(3 * p + i)), y));
                     i += 4;
                 }
+                if p > full {
+                    let m = first(p - full);
+                    let y = tail(x.as_ptr().add(full), m);
+                    s0 = _mm256_add_pd(s0, _mm256_mul_pd(tail(base.add(full), m), y));
+                    s1 = _mm256_add_pd(s1, _mm256_mul_pd(tail(base.add(p + full), m), y));
+                    s2 = _mm256_add_pd(s2, _mm256_mul_pd(tail(base.add(2 * p + full), m), y));
+                    s3 = _mm256_add_pd(s3, _mm256_mul_pd(tail(base.add(3 * p + full), m), y));
+                }
                 for (j, acc) in [s0, s1, s2, s3].into_iter().enumerate() {
-                    let row = &a[(r + j) * p..(r + j + 1) * p];
-                    let mut s = lanes(acc);
-                    for k in 0..p - full {
-                        s[k] += row[full + k] * x[full + k];
-                    }
-                    out[r + j] = combine(s);
+                    out[r + j] = combine(lanes(acc));
                 }
                 r += 4;
             }
@@ -363,15 +423,21 @@ mod avx2 {
                 w = _mm256_add_pd(w, _mm256_mul_pd(_mm256_loadu_pd(f.as_ptr().add(i)), x));
                 i += 4;
             }
-            let (mut e, mut d, mut w) = (lanes(e), lanes(d), lanes(w));
-            for k in 0..p - full {
-                let i = full + k;
-                let x = vs[i] + h * a[i];
-                v[i] = x;
-                e[k] += x * x + w2[i] * q[i] * q[i];
-                d[k] += c[i] * x * x;
-                w[k] += f[i] * x;
+            if p > full {
+                let m = first(p - full);
+                let x = _mm256_add_pd(
+                    tail(vs.as_ptr().add(full), m),
+                    _mm256_mul_pd(hh, tail(a.as_ptr().add(full), m)),
+                );
+                _mm256_maskstore_pd(v.as_mut_ptr().add(full), m, x);
+                let qi = tail(q.as_ptr().add(full), m);
+                let wq = _mm256_mul_pd(tail(w2.as_ptr().add(full), m), qi);
+                e = _mm256_add_pd(e, _mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(wq, qi)));
+                let cx = _mm256_mul_pd(tail(c.as_ptr().add(full), m), x);
+                d = _mm256_add_pd(d, _mm256_mul_pd(cx, x));
+                w = _mm256_add_pd(w, _mm256_mul_pd(tail(f.as_ptr().add(full), m), x));
             }
+            let (e, d, w) = (lanes(e), lanes(d), lanes(w));
             (0.5 * combine(e), combine(d), combine(w))
         }
     }
