@@ -427,3 +427,79 @@ fn run_warns_when_a_mode_is_above_the_critical_velocity() {
         let _ = std::fs::remove_dir_all(s.0.join("out"));
     }
 }
+
+/// `fretdyn sweep` over the gap velocity of the pinned tube: `connors_max_ratio` of each run is
+/// the largest `U_eff/U_c` by hand (the first pair of modes: its critical velocity is a quarter
+/// of the second pair's), and one warning line after the study counts the runs above 1 and
+/// gives the largest ratio; a study of a case without `[flow]` has the column empty and no
+/// warning.
+#[test]
+fn sweep_writes_the_largest_connors_ratio_and_warns_once() {
+    let s = Scratch::new("sweep");
+    std::fs::write(s.0.join("case.toml"), case(1.0)).unwrap();
+    let velocities = [0.5, 2.0, 4.0];
+    std::fs::write(
+        s.0.join("study.toml"),
+        format!(
+            "base = \"case.toml\"\n\n[[parameters]]\nkey = \"flow.zones.0.velocity\"\nvalues = {velocities:?}\n"
+        ),
+    )
+    .unwrap();
+    let out = fretdyn(&["sweep", "study.toml", "-o", "out", "-q"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let table = std::fs::read_to_string(s.0.join("out/study.csv")).unwrap();
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header
+        .iter()
+        .position(|h| *h == "connors_max_ratio")
+        .unwrap();
+    let mut rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    rows.sort_by_key(|r| r[0].parse::<usize>().unwrap());
+    assert_eq!(rows.len(), 3);
+    let expected: Vec<f64> = velocities
+        .iter()
+        .map(|&u| effective(u, 1.0) / critical(1.0))
+        .collect();
+    assert!(expected[0] < 1.0 && expected[1] > 1.0 && expected[2] > 1.0);
+    for (r, want) in rows.iter().zip(&expected) {
+        let got: f64 = r[col].parse().unwrap();
+        assert!((got / want - 1.0).abs() < 1e-6, "{got} vs {want}");
+    }
+    // the first pair has the largest ratio
+    for (&u, want) in velocities.iter().zip(&expected) {
+        assert!(effective(u, 2.0) / critical(2.0) < *want);
+    }
+    let warnings: Vec<&str> = stderr.lines().filter(|l| l.contains("Connors")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    let w = warnings[0];
+    assert!(w.starts_with("warning: study.toml: 2 of 3 runs "), "{w}");
+    let largest: f64 = rows[2][col].parse().unwrap();
+    assert!(
+        w.contains(&format!("U_eff/U_c = {largest:.4}, run 2)")),
+        "{w}"
+    );
+    assert!(w.contains("connors_max_ratio"), "{w}");
+
+    // no [flow]: the column is there, empty; no warning
+    let good = case(1.0);
+    std::fs::write(s.0.join("case.toml"), &good[..good.find("[flow]").unwrap()]).unwrap();
+    std::fs::write(
+        s.0.join("study.toml"),
+        "base = \"case.toml\"\n\n[[parameters]]\nkey = \"structure.damping_ratio\"\nvalues = [0.01, 0.02]\n",
+    )
+    .unwrap();
+    let out = fretdyn(&["sweep", "study.toml", "-o", "bare", "-q"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("Connors"), "{stderr}");
+    let table = std::fs::read_to_string(s.0.join("bare/study.csv")).unwrap();
+    let mut lines = table.lines();
+    assert!(lines.next().unwrap().ends_with(",connors_max_ratio"));
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 2);
+    for r in rows {
+        assert!(r.ends_with(','), "{r}");
+    }
+}
