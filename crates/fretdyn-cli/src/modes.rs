@@ -44,10 +44,19 @@ pub fn main(path: &Path, output: Option<PathBuf>, shown: usize) -> Result<(), Fa
         )?;
     }
     let npz = dir.join("basis.npz");
-    fretdyn::structure::basis_file::write_basis_npz(&npz, basis)
-        .map_err(|e| Failure::failed(e.to_string()))?;
+    fretdyn::structure::basis_file::write_basis_npz_with_abscissae(
+        &npz,
+        basis,
+        &case.point_abscissae,
+    )
+    .map_err(|e| Failure::failed(e.to_string()))?;
+    let with_s = if case.point_abscissae.iter().any(Option::is_some) {
+        ", s_<point>"
+    } else {
+        ""
+    };
     outln!(
-        "wrote {} (keys: frequencies_hz, damping_ratio, rows_<point>, coords_<point>)",
+        "wrote {} (keys: frequencies_hz, damping_ratio, rows_<point>, coords_<point>{with_s})",
         npz.display()
     )?;
     if let Some(tube) = &case.tube {

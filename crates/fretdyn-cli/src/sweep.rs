@@ -5,11 +5,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use fretdyn::apps::study::Study;
+use fretdyn::apps::study::{CONNORS_COLUMN, Study, connors_exceedance};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Failure;
-use crate::out::outln;
+use crate::out::{errln, outln};
 use crate::plot::{Series, panels_plot};
 
 /// Entry point of `fretdyn sweep`.
@@ -63,6 +63,18 @@ pub fn main(
         .execute_checked(&table, jobs, &progress)
         .map_err(|e| Failure::failed(e.in_file(study)))?;
     let wall = start.elapsed().as_secs_f64();
+    // one line for the whole study, not one per mode per run (docs/FLOW.md)
+    if let Some(e) = connors_exceedance(&table).map_err(|e| Failure::failed(e.to_string()))? {
+        errln!(
+            "warning: {}: {} of {} runs have a mode above its Connors critical velocity (largest U_eff/U_c = {:.4}, run {}): fluid-elastic instability expected, see the column {CONNORS_COLUMN} of {}",
+            study.display(),
+            e.runs,
+            e.of,
+            e.largest.0,
+            e.largest.1,
+            table.display()
+        );
+    }
     if let Some(plot) = &s.plot {
         plot_table(&table, &plot.x, &plot.statistic, &dir.join("study.png"))?;
     }

@@ -1,6 +1,7 @@
 //! The native part of the Python package `fretdyn` (module `fretdyn._native`): cases from a
 //! TOML file, TOML text or JSON (Python dicts), runs with the GIL released and Ctrl-C honoured,
-//! results as numpy arrays, and the rows of studies for local or Dask execution. The
+//! results as numpy arrays, the Connors stability check of a case with flow zones, and the
+//! rows of studies for local or Dask execution. The
 //! Python-facing API is `python/fretdyn/__init__.py`.
 
 use std::ops::ControlFlow;
@@ -226,6 +227,47 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
     Ok(out)
 }
 
+/// The Connors fluid-elastic stability check of every mode of a case with a `[flow]` section
+/// (docs/FLOW.md; `fretdyn stability`): a dict of numpy arrays, one per column of
+/// `stability.csv` (`mode`, `frequency_hz`, `damping_ratio`, `reference_density`,
+/// `effective_velocity`, `critical_velocity`, `ratio`: NaN where undefined, inf for an
+/// undamped mode in a flow), `reference_zone` (list of str) and the scalars
+/// `connors_constant`, `diameter`, `mass_per_length`. A case without `[flow]` is a
+/// FretdynError with the CLI's message.
+#[pyfunction]
+fn stability<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
+    let Some(report) = case.inner.stability() else {
+        return Err(FretdynError::new_err(
+            "flow: the case has no [flow] section: add one with its [[flow.zones]] (docs/FLOW.md)",
+        ));
+    };
+    let out = PyDict::new(py);
+    let modes = &report.modes;
+    let mode: Vec<i64> = modes.iter().map(|m| m.mode as i64).collect();
+    out.set_item("mode", PyArray1::from_vec(py, mode))?;
+    type Column = fn(&fretdyn::loads::flow::ModeStability) -> f64;
+    let columns: [(&str, Column); 6] = [
+        ("frequency_hz", |m| m.frequency_hz),
+        ("damping_ratio", |m| m.damping_ratio),
+        ("reference_density", |m| m.reference_density),
+        ("effective_velocity", |m| m.effective_velocity),
+        ("critical_velocity", |m| m.critical_velocity),
+        ("ratio", |m| m.ratio.unwrap_or(f64::NAN)),
+    ];
+    for (key, value) in columns {
+        out.set_item(
+            key,
+            PyArray1::from_vec(py, modes.iter().map(value).collect()),
+        )?;
+    }
+    let zones: Vec<String> = modes.iter().map(|m| m.reference_zone.clone()).collect();
+    out.set_item("reference_zone", zones)?;
+    out.set_item("connors_constant", report.connors_constant)?;
+    out.set_item("diameter", report.diameter)?;
+    out.set_item("mass_per_length", report.mass_per_length)?;
+    Ok(out)
+}
+
 fn study(path: &Path) -> PyResult<fretdyn::apps::study::Study> {
     fretdyn::apps::study::Study::from_file(path).map_err(|e| FretdynError::new_err(e.in_file(path)))
 }
@@ -272,6 +314,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(case_from_toml, m)?)?;
     m.add_function(wrap_pyfunction!(case_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(study_runs, m)?)?;
     m.add_function(wrap_pyfunction!(study_header, m)?)?;
     m.add_function(wrap_pyfunction!(study_row, m)?)?;

@@ -3,6 +3,7 @@ as exceptions with the CLI's messages, cases from dicts and numpy arrays, and a 
 Dask cluster of 2 worker processes equal to the same study run locally. Run by .ci/run in a
 venv where the package is installed (pip install ./crates/fretdyn-python)."""
 
+import json
 import os
 import subprocess
 from pathlib import Path
@@ -269,3 +270,69 @@ def test_ctrl_c_stops_a_run_with_keyboard_interrupt(tmp_path):
     assert p.returncode == 3, out
     assert "interrupted" in out
     assert time.perf_counter() - start < 5.0
+
+
+STABILITY_COLUMNS = [
+    "mode", "frequency_hz", "damping_ratio", "reference_density", "effective_velocity",
+    "critical_velocity", "ratio",
+]
+
+
+def test_stability_equals_the_cli_bit_for_bit(tmp_path):
+    case = EXAMPLES / "ubend_flow.toml"
+    p = cli(["stability", str(case), "-o", "out"], tmp_path)
+    assert p.returncode == 0, p.stderr
+    expected = json.loads((tmp_path / "out" / "stability.json").read_text())
+    modes = expected["modes"]
+    for given in (case, str(case), fretdyn.Case.from_file(case)):
+        s = fretdyn.stability(given)
+        assert set(s) == set(STABILITY_COLUMNS) | {
+            "reference_zone", "connors_constant", "diameter", "mass_per_length"
+        }
+        for key in STABILITY_COLUMNS:
+            assert isinstance(s[key], np.ndarray) and s[key].shape == (len(modes),), key
+            # JSON: null for a ratio that is undefined (NaN here) or infinite (inf here)
+            column = [np.nan if m[key] is None else m[key] for m in modes]
+            want = np.array(column, dtype=s[key].dtype)
+            assert same_bits(s[key], want), key
+        assert s["mode"].dtype.kind == "i"
+        assert s["reference_zone"] == [m["reference_zone"] for m in modes]
+        for key in ("connors_constant", "diameter", "mass_per_length"):
+            assert s[key] == expected[key], key
+    # the example's 11 lowest modes are above their critical velocity (docs/FLOW.md)
+    assert int((s["ratio"] > 1.0).sum()) == 11
+    assert np.array_equal(s["ratio"], s["effective_velocity"] / s["critical_velocity"])
+    with pytest.raises(TypeError, match="fretdyn.stability takes a Case"):
+        fretdyn.stability(42)
+
+
+def test_stability_of_a_case_without_flow_is_an_error(tmp_path):
+    case = EXAMPLES / "v1a_oblique_impact.toml"
+    p = cli(["stability", str(case), "-o", "out"], tmp_path)
+    assert p.returncode == 2
+    with pytest.raises(fretdyn.FretdynError, match=r"no \[flow\] section") as e:
+        fretdyn.stability(case)
+    # the CLI prefixes the file name; the message is the same
+    assert p.stderr.strip() == f"error: {case}: {e.value}"
+
+
+def test_the_run_dict_has_the_fluid_work_of_the_energy_balance(tmp_path):
+    text = (
+        (EXAMPLES / "tube_fluid_elastic.toml").read_text()
+        .replace("duration = 3.0", "duration = 0.05")
+        .replace("t_start = 1.0", "t_start = 0.0")
+    )
+    assert "duration = 0.05" in text and "t_start = 0.0" in text
+    for lift in ("-3.0", "0.0"):
+        body = text.replace("lift_slope = -3.0", f"lift_slope = {lift}")
+        (tmp_path / "case.toml").write_text(body)
+        p = cli(["run", "case.toml", "-o", "out", "-q", "--no-plots"], tmp_path)
+        assert p.returncode == 0, p.stderr
+        summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+        r = fretdyn.run(fretdyn.Case.from_toml(body, tmp_path))
+        work = r["summary"]["energy_balance"]["fluid_work"]
+        assert work == summary["energy_balance"]["fluid_work"]
+        assert work != 0.0
+        if lift == "0.0":
+            # without the delayed lift stiffness the flow only damps: it takes energy out
+            assert work < 0.0, work

@@ -404,6 +404,20 @@ file = "basis.npz"
 "#;
     let case = Case::from_toml_str(text, &dir.0).unwrap();
     assert_eq!(case.model.basis, back);
+    // written without abscissae, read without them; the case knows none
+    assert_eq!(case.point_abscissae, [None, None]);
+    // with the abscissa of one point: `s_<name>` of that one only, read back bit for bit
+    fretdyn::structure::basis_file::write_basis_npz_with_abscissae(
+        &path,
+        &basis,
+        &[None, Some(1.1)],
+    )
+    .unwrap();
+    let file = fretdyn::structure::basis_file::read_basis_npz(&path).unwrap();
+    assert_eq!(file.abscissae, [None, Some(1.1)]);
+    assert_eq!(file.basis.points, basis.points);
+    let case = Case::from_toml_str(text, &dir.0).unwrap();
+    assert_eq!(case.point_abscissae, [None, Some(1.1)]);
 }
 
 #[test]

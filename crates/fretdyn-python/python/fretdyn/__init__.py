@@ -6,6 +6,9 @@ Coulomb friction (explicit central differences; penalty, Active Set or projected
     r = fretdyn.run(case)            # numpy arrays, GIL released, Ctrl-C honoured
     r = fretdyn.run("examples/v1a_oblique_impact.toml")   # the same, from the path
     r["contact_normal_force"][:, 0], r["summary"]["contacts"][0]["wear_work_rate"]
+    r["summary"]["energy_balance"]["fluid_work"]   # the energy the flow fed in, J
+    s = fretdyn.stability("examples/ubend_flow.toml")   # the Connors check, per mode
+    s["ratio"], s["effective_velocity"], s["reference_zone"]
 
 Cases come from a TOML file, TOML text, or a Python dict with the structure of a case file
 (numpy arrays are accepted anywhere a list is). Studies (`sweep`) run on every core, or on a
@@ -25,7 +28,7 @@ import numpy as np
 from . import _native
 from ._native import FretdynError
 
-__all__ = ["Case", "FretdynError", "run", "sweep", "modal_structure", "__version__"]
+__all__ = ["Case", "FretdynError", "run", "stability", "sweep", "modal_structure", "__version__"]
 __version__ = _native.__version__
 
 PathLike = Union[str, os.PathLike]
@@ -107,26 +110,46 @@ def modal_structure(
     return structure
 
 
-def run(case: Union[Case, PathLike]) -> dict:
-    """Runs a case, or the case file at a path (str or os.PathLike), like `fretdyn run` (the
-    GIL is released; Ctrl-C raises KeyboardInterrupt). Returns the arrays of `results.npz` as
-    numpy arrays and `summary`, the content of `summary.json` as a dict. A diverged run
-    returns what it computed; its `summary["termination"]` says where."""
+def _case(case: Union[Case, PathLike], function: str) -> Case:
+    """`case` itself, or the case file at a path (str or os.PathLike); `function` names the
+    caller in the TypeError of anything else."""
     if isinstance(case, (str, os.PathLike)):
         if isinstance(case, str) and "\n" in case:
             raise TypeError(
-                "fretdyn.run: a str is the path of a case file; for TOML text use "
-                "fretdyn.run(fretdyn.Case.from_toml(text))"
+                f"fretdyn.{function}: a str is the path of a case file; for TOML text use "
+                f"fretdyn.{function}(fretdyn.Case.from_toml(text))"
             )
-        case = Case.from_file(case)
-    elif not isinstance(case, Case):
+        return Case.from_file(case)
+    if not isinstance(case, Case):
         raise TypeError(
-            "fretdyn.run takes a Case (Case.from_file, Case.from_toml, Case.from_dict) or the "
-            f"path of a case file (str or os.PathLike), not {type(case).__name__}"
+            f"fretdyn.{function} takes a Case (Case.from_file, Case.from_toml, Case.from_dict) "
+            f"or the path of a case file (str or os.PathLike), not {type(case).__name__}"
         )
+    return case
+
+
+def run(case: Union[Case, PathLike]) -> dict:
+    """Runs a case, or the case file at a path (str or os.PathLike), like `fretdyn run` (the
+    GIL is released; Ctrl-C raises KeyboardInterrupt). Returns the arrays of `results.npz` as
+    numpy arrays and `summary`, the content of `summary.json` as a dict (its
+    `energy_balance` includes `fluid_work`, the work of the fluid-elastic forces, J). A
+    diverged run returns what it computed; its `summary["termination"]` says where."""
+    case = _case(case, "run")
     out = _native.run(case._native)
     out["summary"] = json.loads(out.pop("summary_json"))
     return out
+
+
+def stability(case: Union[Case, PathLike]) -> dict:
+    """The Connors fluid-elastic stability check of every mode of a case with a `[flow]`
+    section, or of the case file at a path, like `fretdyn stability` (docs/FLOW.md). Returns
+    one numpy array per column of `stability.csv` — `mode`, `frequency_hz` (Hz),
+    `damping_ratio`, `reference_density` (kg/m³), `effective_velocity` and
+    `critical_velocity` (m/s), `ratio` (U_eff/U_c; NaN where undefined, inf for an undamped
+    mode in a flow) — `reference_zone` (list of str), and the scalars `connors_constant`,
+    `diameter` (m) and `mass_per_length` (kg/m). A case without `[flow]` raises
+    FretdynError."""
+    return _native.stability(_case(case, "stability")._native)
 
 
 def _read_done(table: Path, header: str) -> set:

@@ -303,7 +303,8 @@ impl Study {
     }
 
     /// Header of the table: run, each parameter, seed, status, steps/s, then
-    /// `<contact>.<statistic>` for every contact of the base case.
+    /// `<contact>.<statistic>` for every contact of the base case, then
+    /// [`CONNORS_COLUMN`].
     pub fn header(&self, contacts: &[String]) -> String {
         let mut cols = vec!["run".to_string()];
         cols.extend(self.parameters.iter().map(|p| p.key.clone()));
@@ -313,6 +314,7 @@ impl Study {
                 cols.push(format!("{c}.{s}"));
             }
         }
+        cols.push(CONNORS_COLUMN.to_string());
         cols.join(",")
     }
 
@@ -451,8 +453,63 @@ impl Study {
                 cols.push(v[s].as_f64().map(|x| x.to_string()).unwrap_or_default());
             }
         }
+        cols.push(
+            case.stability()
+                .and_then(|report| report.max_ratio())
+                .map(|x| x.to_string())
+                .unwrap_or_default(),
+        );
         Ok(cols.join(","))
     }
+}
+
+/// Column of the study table with the largest Connors ratio `U_eff/U_c` over the modes of
+/// the run's case (docs/FLOW.md; `inf` for an undamped mode in a flow; empty without
+/// `[flow]`).
+pub const CONNORS_COLUMN: &str = "connors_max_ratio";
+
+/// The runs of a study table whose case has a mode above its Connors critical velocity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConnorsExceedance {
+    /// Runs with `connors_max_ratio > 1`.
+    pub runs: usize,
+    /// Runs in the table.
+    pub of: usize,
+    /// The largest ratio, and the index of its run.
+    pub largest: (f64, usize),
+}
+
+/// Reads the [`CONNORS_COLUMN`] of a study table (complete rows only): `None` when no run
+/// has a ratio above 1 (or the table has no such column).
+pub fn connors_exceedance(table: &Path) -> Result<Option<ConnorsExceedance>> {
+    let text = std::fs::read_to_string(table).map_err(|e| Error::io(table, e))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let Some(col) = header.iter().position(|h| *h == CONNORS_COLUMN) else {
+        return Ok(None);
+    };
+    let rows: Vec<Vec<&str>> = lines
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|r| r.len() == header.len())
+        .collect();
+    let mut found: Option<ConnorsExceedance> = None;
+    for r in &rows {
+        let (Ok(ratio), Ok(run)) = (r[col].parse::<f64>(), r[0].parse::<usize>()) else {
+            continue;
+        };
+        if ratio > 1.0 {
+            let f = found.get_or_insert(ConnorsExceedance {
+                runs: 0,
+                of: rows.len(),
+                largest: (ratio, run),
+            });
+            f.runs += 1;
+            if ratio > f.largest.0 {
+                f.largest = (ratio, run);
+            }
+        }
+    }
+    Ok(found)
 }
 
 /// Runs `case` for its statistics (THEORY §5) only: neither the time histories (a recorder of

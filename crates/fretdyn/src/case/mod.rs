@@ -56,6 +56,12 @@ pub struct Case {
     pub tube: Option<Box<TubeModel>>,
     /// The `[flow]` section: flow zones sampled on the modes (docs/FLOW.md).
     pub flow: Option<Box<Flow>>,
+    /// The abscissa `s` along the tube of each point of the basis (same order as
+    /// `model.basis.points`), m, where known: a tube's named points (at their node), the
+    /// `s_<name>` of a `.npz`, `s = …` of inline points, a pinned beam's stations. The
+    /// curvilinear coordinate of the `[[flow.zones]]` (docs/FLOW.md); `fretdyn modes` writes
+    /// them as `s_<name>`.
+    pub point_abscissae: Vec<Option<f64>>,
 }
 
 impl Case {
@@ -79,7 +85,7 @@ impl Case {
         let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
         let title = file.title.clone().unwrap_or_default();
         let mut warnings = Vec::new();
-        let (model, settings, tube, flow) = file.build(base, &mut warnings)?;
+        let (model, settings, tube, flow, point_abscissae) = file.build(base, &mut warnings)?;
         Ok(Self {
             title,
             model,
@@ -88,6 +94,7 @@ impl Case {
             tube,
             flow,
             warnings,
+            point_abscissae,
         })
     }
 
@@ -101,6 +108,7 @@ impl Case {
             warnings: Vec::new(),
             tube: None,
             flow: None,
+            point_abscissae: Vec::new(),
         }
     }
 
@@ -179,12 +187,14 @@ fn v3(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
 }
 
-/// What a case file builds: the model, the settings, a tube's finite-element model, the flow.
+/// What a case file builds: the model, the settings, a tube's finite-element model, the flow,
+/// the abscissae of the basis's points.
 type Built = (
     Model,
     RunSettings,
     Option<Box<TubeModel>>,
     Option<Box<Flow>>,
+    Vec<Option<f64>>,
 );
 
 impl CaseFile {
@@ -212,7 +222,9 @@ impl CaseFile {
         self.build_initial(&mut model)?;
         model.validate()?;
         let settings = self.settings(&model)?;
-        Ok((model, settings, tube, flow))
+        let mut point_abscissae = abscissae.s;
+        point_abscissae.resize(model.basis.points.len(), None);
+        Ok((model, settings, tube, flow, point_abscissae))
     }
 }
 

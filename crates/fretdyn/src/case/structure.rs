@@ -385,10 +385,14 @@ impl StructureSection {
         if let StructureSection::Tube(t) = self {
             let structure = t.structure()?;
             let basis = structure.modal_basis()?;
+            let abscissae = Abscissae {
+                s: structure.point_abscissae().into_iter().map(Some).collect(),
+                source: "the tube's named points (at their node's arc length)".into(),
+            };
             return Ok((
                 basis.basis.clone(),
                 Some(Box::new(TubeModel { structure, basis })),
-                Abscissae::default(),
+                abscissae,
             ));
         }
         let mut abscissae = Abscissae::default();

@@ -347,6 +347,12 @@ impl StabilityReport {
         self.modes.iter().filter(|m| m.unstable())
     }
 
+    /// The largest `U_eff / U_c` over the modes (`∞` for an undamped mode in a flow); `None`
+    /// when no mode has a ratio (no modes, or `U_eff = U_c = 0` for all).
+    pub fn max_ratio(&self) -> Option<f64> {
+        self.modes.iter().filter_map(|m| m.ratio).reduce(f64::max)
+    }
+
     /// One row per mode under [`STABILITY_CSV_HEADER`]; numbers in Rust's shortest round-trip
     /// form, an undefined or infinite ratio as an empty field or `inf`. Zone names need no
     /// quoting (letters, digits, `_`, `-`, `.` only).

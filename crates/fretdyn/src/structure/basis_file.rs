@@ -215,8 +215,20 @@ pub struct BasisFile {
     pub abscissae: Vec<Option<f64>>,
 }
 
-/// Writes a modal basis as `.npz` (keys in the module documentation).
+/// Writes a modal basis as `.npz` (keys in the module documentation), without abscissae.
 pub fn write_basis_npz(path: &Path, basis: &ModalBasis) -> Result<()> {
+    write_basis_npz_with_abscissae(path, basis, &[])
+}
+
+/// Writes a modal basis as `.npz` (keys in the module documentation), with `s_<name>` (shape
+/// (1,), m) for every point whose abscissa along the tube is given: `abscissae[k]` is that of
+/// `basis.points[k]` (missing or `None`: no key). With them, the `[[flow.zones]]` of a case
+/// can be placed on the basis read back (docs/FLOW.md).
+pub fn write_basis_npz_with_abscissae(
+    path: &Path,
+    basis: &ModalBasis,
+    abscissae: &[Option<f64>],
+) -> Result<()> {
     let p = basis.modes();
     write_atomically(path, |file| {
         let e = |err: ndarray_npy::WriteNpzError| std::io::Error::other(err.to_string());
@@ -234,7 +246,7 @@ pub fn write_basis_npz(path: &Path, basis: &ModalBasis) -> Result<()> {
                 .map_err(|err| std::io::Error::other(err.to_string()))?;
             npz.add_array("participation", &g).map_err(e)?;
         }
-        for pt in &basis.points {
+        for (k, pt) in basis.points.iter().enumerate() {
             let rows = Array2::from_shape_vec((3, p), pt.rows.clone())
                 .map_err(|err| std::io::Error::other(err.to_string()))?;
             npz.add_array(format!("rows_{}", pt.name), &rows)
@@ -250,6 +262,10 @@ pub fn write_basis_npz(path: &Path, basis: &ModalBasis) -> Result<()> {
                 &Array1::from(pt.coords.iter().copied().collect::<Vec<_>>()),
             )
             .map_err(e)?;
+            if let Some(Some(s)) = abscissae.get(k) {
+                npz.add_array(format!("s_{}", pt.name), &Array1::from(vec![*s]))
+                    .map_err(e)?;
+            }
         }
         npz.finish().map_err(e)?;
         Ok(())

@@ -299,6 +299,15 @@ impl TubeStructure {
         s
     }
 
+    /// Arc length `s` of every named point along the tube, m: that of its node
+    /// ([`TubeStructure::node_abscissae`]; an offset from the axis does not move it), in the
+    /// order of [`TubeStructure::points`] — the abscissae the flow zones are placed on
+    /// (docs/FLOW.md), written as `s_<name>` by `fretdyn modes`.
+    pub fn point_abscissae(&self) -> Vec<f64> {
+        let s = self.node_abscissae();
+        self.points.iter().map(|pt| s[pt.node]).collect()
+    }
+
     /// Quadrature stations over the arc-length span `[s0, s1]`: 4 Gauss–Legendre points on each
     /// element's overlap with the span, with the translation rows of the axis there from the
     /// element's own interpolation of the modes (docs/FLOW.md): along the unit tangent `t`
