@@ -28,7 +28,7 @@ pub enum Error {
     /// Δt is above the stability limit of central differences (THEORY §2).
     #[error(
         "time.dt = {dt:e} s is above the stable limit {limit:e} s of central differences \
-         (highest modal frequency plus contact penalty stiffnesses, docs/THEORY.md §2): set time.dt ≤ {suggest:e}"
+         (highest modal frequency plus contact penalty stiffnesses and fluid-elastic forces, docs/THEORY.md §2, §13): set time.dt ≤ {suggest:e}"
     )]
     UnstableTimeStep { dt: f64, limit: f64, suggest: f64 },
 

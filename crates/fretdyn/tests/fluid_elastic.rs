@@ -420,3 +420,27 @@ fn supports_bound_the_motion_above_the_threshold() {
         );
     }
 }
+
+/// The stable time step counts the explicit fluid forces (THEORY §13): a fluid stiffness of
+/// 3 ω₀² (bound added to ω₀²) halves the limit `2/ω`, and a Δt between the two limits is
+/// refused with the new limit; bad matrices are refused naming the group.
+#[test]
+fn stable_time_step_and_bad_input_count_the_fluid_forces() {
+    use fretdyn::integrator::simulation::Simulation;
+    let w0 = std::f64::consts::TAU * F0;
+    let alone = Simulation::check(&model(delayed(0.0, 0.0, 0.0)), &settings(1e-5, 0.01)).unwrap();
+    let stiff = delayed(-3.0 * w0 * w0, 0.01, 0.0);
+    let limit = Simulation::check(&model(stiff.clone()), &settings(1e-5, 0.01)).unwrap();
+    assert!((alone / limit - 2.0).abs() < 1e-3, "{alone} {limit}");
+    let between = 0.75 * alone;
+    let err = Simulation::check(&model(stiff), &settings(between, 0.01)).unwrap_err();
+    assert!(err.to_string().contains("fluid-elastic forces"), "{err}");
+    let mut nan = delayed(1.0, 0.01, 0.0);
+    nan.delayed[0].stiffness = ModalMatrix::Dense(vec![f64::NAN]);
+    let err = Simulation::check(&model(nan), &settings(1e-5, 0.01)).unwrap_err();
+    assert_eq!(err.field(), Some("test"), "{err}");
+    let mut wrong = delayed(1.0, 0.01, 0.0);
+    wrong.delayed[0].delay = -1.0;
+    let err = Simulation::check(&model(wrong), &settings(1e-5, 0.01)).unwrap_err();
+    assert_eq!(err.field(), Some("test.delay"), "{err}");
+}
