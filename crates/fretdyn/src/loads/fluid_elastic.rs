@@ -68,10 +68,9 @@ impl ModalMatrix {
                 ModalMatrix::Diagonal(a.iter().zip(b).map(|(x, y)| x + y).collect())
             }
             _ => {
+                // one of them is dense: p × p values
                 let p = match (self, other) {
-                    (ModalMatrix::Dense(m), _) | (_, ModalMatrix::Dense(m)) => {
-                        (m.len() as f64).sqrt().round() as usize
-                    }
+                    (ModalMatrix::Dense(m), _) | (_, ModalMatrix::Dense(m)) => m.len().isqrt(),
                     _ => 0,
                 };
                 let mut out = self.dense(p);
@@ -226,24 +225,28 @@ impl FluidElastic {
         };
         let mut damping = vec![0.0; p * p];
         let (mut lift, mut drag) = (vec![0.0; p], vec![0.0; p]);
+        // one node's stiffness, added to its delay group's
+        let mut k = vec![0.0; p * p];
         for n in nodes {
             n.directional_rows(&mut lift, &mut drag);
             let q = 0.5 * n.density * n.velocity * n.velocity * n.weight;
-            let delay = n.delay;
-            let mut k = vec![0.0; p * p];
+            k.fill(0.0);
             add_outer(&mut k, q * coefficients.lift_slope, &lift);
             add_outer(&mut k, q * coefficients.drag_slope, &drag);
             let c = n.density * n.velocity * n.diameter * coefficients.drag * n.weight;
             add_outer(&mut damping, 0.5 * c, &lift);
             add_outer(&mut damping, c, &drag);
-            out.merge(FluidElastic {
-                delayed: vec![DelayedStiffness {
+            match out.delayed.iter_mut().find(|g| g.delay == n.delay) {
+                Some(DelayedStiffness {
+                    stiffness: ModalMatrix::Dense(h),
+                    ..
+                }) => h.iter_mut().zip(&k).for_each(|(h, k)| *h += k),
+                _ => out.delayed.push(DelayedStiffness {
                     name: name.to_string(),
-                    delay,
-                    stiffness: ModalMatrix::Dense(k),
-                }],
-                damping: Vec::new(),
-            });
+                    delay: n.delay,
+                    stiffness: ModalMatrix::Dense(k.clone()),
+                }),
+            }
         }
         out.damping.push(ModalMatrix::Dense(damping));
         out
