@@ -2,6 +2,7 @@
 
 mod against_c;
 mod bench;
+mod life;
 mod modes;
 mod out;
 mod plot;
@@ -111,6 +112,20 @@ enum Command {
         /// Output folder [default: fretdyn_results/<case name>_stability].
         #[arg(short, long, value_parser = path)]
         output: Option<PathBuf>,
+    },
+    /// Service life of a case with a [life] section and contacts with wear (docs/WEAR.md):
+    /// windows of vibration, scar growth, the scars fed back into the obstacles, to the
+    /// target time; writes life.csv, life.json, scars.csv and life.png.
+    Life {
+        /// Case file (TOML) with [life] and contacts with `wear`.
+        #[arg(value_parser = path)]
+        case: PathBuf,
+        /// Output folder [default: fretdyn_results/<case name>_life].
+        #[arg(short, long, value_parser = path)]
+        output: Option<PathBuf>,
+        /// Do not draw life.png.
+        #[arg(long)]
+        no_plots: bool,
     },
     /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube (or, with
     /// --against-c, side by side with a plain C implementation of the step).
@@ -258,6 +273,11 @@ fn main() -> ExitCode {
             shown,
         } => modes::main(&case, output, shown),
         Command::Stability { case, output } => stability::main(&case, output),
+        Command::Life {
+            case,
+            output,
+            no_plots,
+        } => life::main(&case, output, !no_plots),
         Command::Bench {
             steps,
             repeat,

@@ -4,8 +4,10 @@
 //! - [`study`]: parameter studies — one case file, a grid of values, one run per point;
 //! - [`verification`]: the verification cases against closed forms (THEORY §6,
 //!   `docs/VERIFICATION.md`);
-//! - [`benchmark`]: the step-speed benchmark case (`docs/PERFORMANCE.md`).
+//! - [`benchmark`]: the step-speed benchmark case (`docs/PERFORMANCE.md`);
+//! - [`life`]: the service life — wear depth over years with the scars fed back (THEORY §14.5).
 
 pub mod benchmark;
+pub mod life;
 pub mod study;
 pub mod verification;

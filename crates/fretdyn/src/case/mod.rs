@@ -10,13 +10,15 @@
 //! - `loads`: `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]`, `[[turbulence]]`,
 //!   `[base_excitation]`;
 //! - `flow`: `[flow]` and its `[[flow.zones]]`;
-//! - `settings`: `[time]`, `[tangential]`, `[output]`, `[statistics]`.
+//! - `settings`: `[time]`, `[tangential]`, `[output]`, `[statistics]`;
+//! - `life`: `[life]`, the service life of `fretdyn life`.
 //!
 //! This module reads the file, holds the top-level schema (`CaseFile`) and builds the
 //! sections in order.
 
 mod contacts;
 mod flow;
+mod life;
 mod loads;
 mod settings;
 mod structure;
@@ -25,6 +27,7 @@ pub use structure::TubeModel;
 
 use contacts::ContactSection;
 use flow::FlowSection;
+use life::LifeSection;
 use loads::{BaseSection, LineLoadSection, LoadSection, ModalLoadSection, TurbulenceSection};
 use settings::{OutputSection, StatisticsSection, TangentialSection, TimeSection};
 use structure::{InitialSection, StructureSection};
@@ -62,6 +65,8 @@ pub struct Case {
     /// curvilinear coordinate of the `[[flow.zones]]` (docs/FLOW.md); `fretdyn modes` writes
     /// them as `s_<name>`.
     pub point_abscissae: Vec<Option<f64>>,
+    /// The `[life]` section: the service life (THEORY §14.5), for `fretdyn life`.
+    pub life: Option<crate::apps::life::LifeSettings>,
 }
 
 impl Case {
@@ -85,7 +90,13 @@ impl Case {
         let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
         let title = file.title.clone().unwrap_or_default();
         let mut warnings = Vec::new();
+        let mut file = file;
+        let life_section = file.life.take();
         let (model, settings, tube, flow, point_abscissae) = file.build(base, &mut warnings)?;
+        let life = match life_section {
+            Some(l) => Some(l.build(tube.as_deref())?),
+            None => None,
+        };
         Ok(Self {
             title,
             model,
@@ -95,6 +106,7 @@ impl Case {
             flow,
             warnings,
             point_abscissae,
+            life,
         })
     }
 
@@ -109,6 +121,7 @@ impl Case {
             tube: None,
             flow: None,
             point_abscissae: Vec::new(),
+            life: None,
         }
     }
 
@@ -181,6 +194,7 @@ struct CaseFile {
     output: OutputSection,
     #[serde(default)]
     statistics: StatisticsSection,
+    life: Option<LifeSection>,
 }
 
 fn v3(a: [f64; 3]) -> Vector3<f64> {

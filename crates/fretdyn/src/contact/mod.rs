@@ -5,6 +5,7 @@
 //! Delassus operator ([`delassus`]) solved by the [`tangential`] methods (THEORY §4, §7, §8).
 //!
 //! - [`obstacle`]: planes, bi-planes, circles, polygons: gap, normal, tangent frame;
+//! - [`scar`]: the clearance a wear scar adds to an obstacle (THEORY §14.4);
 //! - [`frame_rows`]: the frame of a plane or bars projected on the modes (detection in one
 //!   dot product);
 //! - [`motion`]: the imposed motion of an obstacle (THEORY §8);
@@ -20,6 +21,7 @@ pub mod frame_rows;
 pub mod friction;
 pub mod motion;
 pub mod obstacle;
+pub mod scar;
 pub mod tangential;
 
 use crate::contact::friction::Coulomb;

@@ -3,6 +3,7 @@
 
 use nalgebra::{Vector2, Vector3};
 
+use crate::contact::scar::{AngularProfile, ObstacleWear};
 use crate::error::{Error, Result};
 
 /// What a contact needs from the obstacle at one instant.
@@ -139,6 +140,8 @@ pub struct Circle {
     clearance: f64,
     /// An in-plane unit vector, for the frame of a point exactly on the axis.
     e1: Vector3<f64>,
+    /// The wear scar's depth profile, in the axes `(e1, a × e1)` (THEORY §14.4).
+    scar: Option<Box<AngularProfile>>,
 }
 
 impl Circle {
@@ -174,6 +177,7 @@ impl Circle {
             axis,
             clearance,
             e1: default_tangent(&axis).normalize(),
+            scar: None,
         })
     }
 
@@ -183,10 +187,42 @@ impl Circle {
         let r = d - self.axis * self.axis.dot(&d);
         let rho = r.norm();
         let radial = if rho > 0.0 { r / rho } else { self.e1 };
+        if let Some(scar) = &self.scar {
+            return self.worn_frame(scar, rho, radial);
+        }
         ContactFrame {
             penetration: rho - self.clearance,
             normal: -radial,
             tangents: [self.axis.cross(&radial), self.axis],
+            velocity: Vector3::zeros(),
+        }
+    }
+
+    /// The frame in a worn hole (module [`crate::contact::scar`]): `φ = ρ − c − d(θ)`,
+    /// `δ = φ/|∇φ|`, `n = −∇φ/|∇φ|`, `∇φ = e_ρ − (d'(θ)/ρ) e_θ`. Inside the least worn
+    /// radius `c + min d` the contact is open and its remaining clearance is measured to
+    /// that radius (no angle needed).
+    #[inline(never)]
+    fn worn_frame(&self, scar: &AngularProfile, rho: f64, radial: Vector3<f64>) -> ContactFrame {
+        let e_theta = self.axis.cross(&radial);
+        if rho <= self.clearance + scar.min() {
+            return ContactFrame {
+                penetration: rho - self.clearance - scar.min(),
+                normal: -radial,
+                tangents: [e_theta, self.axis],
+                velocity: Vector3::zeros(),
+            };
+        }
+        let e2 = self.axis.cross(&self.e1);
+        let theta = radial.dot(&e2).atan2(radial.dot(&self.e1));
+        let (depth, slope) = scar.at(theta);
+        let grad = radial - e_theta * (slope / rho);
+        let norm = grad.norm();
+        let normal = -grad / norm;
+        ContactFrame {
+            penetration: (rho - self.clearance - depth) / norm,
+            normal,
+            tangents: [self.axis.cross(&-normal), self.axis],
             velocity: Vector3::zeros(),
         }
     }
@@ -253,6 +289,8 @@ pub struct Polygon {
     e1: Vector3<f64>,
     e2: Vector3<f64>,
     vertices: Vec<Vector2<f64>>,
+    /// The wear scar's depth profile, in the axes `(e1, e2)` (THEORY §14.4).
+    scar: Option<Box<AngularProfile>>,
 }
 
 impl Polygon {
@@ -312,6 +350,7 @@ impl Polygon {
             e1,
             e2: a.cross(&e1),
             vertices,
+            scar: None,
         };
         if !polygon.contains(&Vector2::zeros()) {
             return Err(Error::invalid(
@@ -375,8 +414,10 @@ impl Polygon {
             -r / r.norm().max(1e-300)
         };
         let normal = self.e1 * n2.x + self.e2 * n2.y;
+        // a worn hole: the boundary recedes by d(θ) along its normal
+        let scar = self.scar.as_ref().map_or(0.0, |s| s.at(r.y.atan2(r.x)).0);
         ContactFrame {
-            penetration: if inside { -dist } else { dist },
+            penetration: (if inside { -dist } else { dist }) - scar,
             normal,
             tangents: [normal.cross(&self.axis), self.axis],
             velocity: Vector3::zeros(),
@@ -435,6 +476,48 @@ impl Obstacle {
         }
     }
 
+    /// The unworn obstacle with a wear scar (THEORY §14.4; module [`crate::contact::scar`]):
+    /// a plane recedes by a [`ObstacleWear::Uniform`] depth, bars by their
+    /// [`ObstacleWear::Sides`] depths, a hole takes an [`ObstacleWear::Angular`] profile. Another
+    /// pairing, or a depth that is not finite and ≥ 0, is an error naming `field`.
+    pub fn worn(&self, wear: &ObstacleWear, field: &str) -> Result<Obstacle> {
+        let bad = |what: &str| {
+            Error::invalid(
+                field.to_string(),
+                format!("a {} obstacle cannot take {what}", self.kind()),
+            )
+        };
+        let depth_ok = |d: f64| d.is_finite() && d >= 0.0;
+        match (self, wear) {
+            (Obstacle::Plane(p), ObstacleWear::Uniform(d)) if depth_ok(*d) => {
+                let mut worn = p.clone();
+                worn.gap += d;
+                Ok(Obstacle::Plane(worn))
+            }
+            (Obstacle::BiPlane(b), ObstacleWear::Sides { positive, negative })
+                if depth_ok(*positive) && depth_ok(*negative) =>
+            {
+                let mut worn = b.clone();
+                worn.origin += b.normal * (0.5 * (positive - negative));
+                worn.gap += 0.5 * (positive + negative);
+                Ok(Obstacle::BiPlane(worn))
+            }
+            (Obstacle::Circle(c), ObstacleWear::Angular(profile)) => {
+                let mut worn = c.clone();
+                worn.scar = Some(Box::new(profile.clone()));
+                Ok(Obstacle::Circle(worn))
+            }
+            (Obstacle::Polygon(p), ObstacleWear::Angular(profile)) => {
+                let mut worn = p.clone();
+                worn.scar = Some(Box::new(profile.clone()));
+                Ok(Obstacle::Polygon(worn))
+            }
+            (_, ObstacleWear::Uniform(_)) => Err(bad("a uniform depth ≥ 0")),
+            (_, ObstacleWear::Sides { .. }) => Err(bad("two side depths ≥ 0")),
+            (_, ObstacleWear::Angular(_)) => Err(bad("a depth profile around a hole")),
+        }
+    }
+
     /// Name of the obstacle's type, as in case files.
     pub fn kind(&self) -> &'static str {
         match self {
@@ -453,7 +536,8 @@ impl Obstacle {
                 (0..=180)
                     .map(|k| {
                         let a = std::f64::consts::TAU * k as f64 / 180.0;
-                        [c.clearance * a.cos(), c.clearance * a.sin()]
+                        let r = c.clearance + c.scar.as_ref().map_or(0.0, |s| s.at(a).0);
+                        [r * a.cos(), r * a.sin()]
                     })
                     .collect(),
             ),

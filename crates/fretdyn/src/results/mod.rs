@@ -6,7 +6,8 @@
 //! - [`statistics`]: per-contact wear work rate, impacts, slip, blocks (THEORY §5, §11);
 //! - [`energy`]: the discrete energy balance (THEORY §5);
 //! - [`output`]: `results.npz` and `summary.json`;
-//! - [`stream`]: long runs streamed to disk by chunks, checkpoints and resume.
+//! - [`stream`]: long runs streamed to disk by chunks, checkpoints and resume;
+//! - [`wear_map`]: where each contact's friction work is done, for the service life.
 //!
 //! The step loop ([`crate::integrator`]) writes into [`recorder`], [`statistics`] and [`energy`];
 //! [`output`] and [`stream`] read the finished or running simulation.
@@ -16,3 +17,4 @@ pub mod output;
 pub mod recorder;
 pub mod statistics;
 pub mod stream;
+pub mod wear_map;

@@ -100,7 +100,7 @@ impl StatisticsSettings {
     /// Whether the step ending at `t` counts: its midpoint `t − Δt/2` is in the window (the
     /// step times `nΔt` are not exact multiples of the window's bounds in floating point).
     #[inline]
-    fn step_in_window(&self, t: f64, dt: f64) -> bool {
+    pub(crate) fn step_in_window(&self, t: f64, dt: f64) -> bool {
         self.in_window(t - 0.5 * dt)
     }
 

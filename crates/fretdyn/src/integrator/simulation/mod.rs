@@ -45,6 +45,7 @@ use crate::model::Model;
 use crate::results::energy::{EnergyBalance, EnergyRaw};
 use crate::results::recorder::Recorder;
 use crate::results::statistics::ContactStatisticsState;
+use crate::results::wear_map::WearMap;
 use crate::structure::modal::project_add;
 
 /// Everything that the steps after step `step` depend on: a run restored from it continues
@@ -202,6 +203,8 @@ pub struct Simulation<'m> {
     accumulation_bound: f64,
     /// Run the steps as code compiled for AVX2 and FMA ([`Self::step`]).
     wide: bool,
+    /// Where the friction work is done, when tracked ([`Self::track_wear`]).
+    wear_map: Option<WearMap>,
 }
 
 impl<'m> Simulation<'m> {
@@ -341,6 +344,18 @@ impl<'m> Simulation<'m> {
             energy: self.energy.raw(),
             fluid: self.fluid.as_ref().map(|f| f.history()),
         }
+    }
+
+    /// Tracks where each contact's friction work is done, from now on, `angular_bins` around
+    /// each hole ([`WearMap`]; for the service life, THEORY §14.4). Not carried by
+    /// checkpoints.
+    pub fn track_wear(&mut self, angular_bins: usize) {
+        self.wear_map = Some(WearMap::new(self.model, angular_bins));
+    }
+
+    /// Where the friction work was done, when tracked ([`Self::track_wear`]).
+    pub fn wear_map(&self) -> Option<&WearMap> {
+        self.wear_map.as_ref()
     }
 
     /// Steps done.
@@ -536,6 +551,7 @@ impl<'m> Simulation<'m> {
             force: vec![0.0; p],
             names: model.contacts.iter().map(|c| c.name.clone()).collect(),
             statistics: ContactStatisticsState::new(nc, &settings.statistics),
+            wear_map: None,
             solver_stats: SolverStatistics::default(),
             stable_dt,
             energy: EnergyBalance::default(),
@@ -669,6 +685,9 @@ impl<'m> Simulation<'m> {
             .map(|((s, c), rows)| step_values(s, c, rows.as_ref(), t));
         self.statistics
             .step(&self.settings.statistics, &self.names, t, dt, values);
+        if let Some(map) = &mut self.wear_map {
+            track_wear(map, &self.contacts, model, &self.frame_rows, t, dt, self.settings);
+        }
         if sample {
             self.next_sample = self.next_sample.saturating_add(self.settings.output_every);
         }
@@ -705,6 +724,28 @@ fn contact_states<'a>(
     states: &'a mut [ContactState],
 ) -> impl Iterator<Item = (usize, (&'a crate::contact::Contact, &'a mut ContactState))> {
     model.contacts.iter().zip(states).enumerate()
+}
+
+/// Adds the step's friction work of the closed contacts to `map`, when the step is in the
+/// statistics window.
+#[inline(never)]
+fn track_wear(
+    map: &mut WearMap,
+    states: &[ContactState],
+    model: &Model,
+    frame_rows: &[Option<FrameRows>],
+    t: f64,
+    dt: f64,
+    settings: &RunSettings,
+) {
+    if !settings.statistics.step_in_window(t, dt) {
+        return;
+    }
+    for (k, ((s, c), rows)) in states.iter().zip(&model.contacts).zip(frame_rows).enumerate() {
+        if s.closed {
+            map.add(k, &step_values(s, c, rows.as_ref(), t), dt);
+        }
+    }
 }
 
 /// Whether the processor runs AVX2 and FMA code ([`Simulation::step`]).

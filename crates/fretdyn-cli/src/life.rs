@@ -1,0 +1,233 @@
+//! `fretdyn life CASE.toml`: the service life of a case with a `[life]` section and contacts
+//! with `wear` (THEORY §14.5, docs/WEAR.md) — windows of vibration, scar growth, the scars
+//! fed back into the obstacles, until the target time. Writes `life.csv` (one row per life
+//! step), `life.json` (the whole result), `scars.csv` (final scar profiles) and `life.png`.
+//! The library computes ([`fretdyn::apps::life::service_life`]); this prints and writes.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use fretdyn::apps::life::{LifeEnd, LifeResults, LifeStep, YEAR, service_life};
+use fretdyn::case::Case;
+
+use crate::Failure;
+use crate::out::{errln, outln};
+use crate::plot::{self, Series};
+
+/// Entry point of `fretdyn life`.
+pub fn main(path: &Path, output: Option<PathBuf>, plots: bool) -> Result<(), Failure> {
+    let case = Case::from_file(path).map_err(|e| Failure::input(e.in_file(path)))?;
+    for w in &case.warnings {
+        errln!("warning: {w}");
+    }
+    let Some(life) = case.life.clone() else {
+        return Err(Failure::input(format!(
+            "{}: life: the case has no [life] section: add one with target_years (docs/WEAR.md)",
+            path.display()
+        )));
+    };
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "case".into());
+    let dir =
+        output.unwrap_or_else(|| PathBuf::from("fretdyn_results").join(format!("{stem}_life")));
+    std::fs::create_dir_all(&dir).map_err(|e| {
+        Failure::failed(format!("{}: cannot create the folder: {e}", dir.display()))
+    })?;
+    outln!(
+        "{}: service life to {} years, windows of {} s, depth change ≤ {} per step{}",
+        case.title,
+        life.target / YEAR,
+        case.settings.steps as f64 * case.settings.dt,
+        life.max_depth_change,
+        if life.feedback {
+            ""
+        } else {
+            " (fixed gap: no feedback)"
+        }
+    )?;
+    let mut printed = Ok(());
+    let results = service_life(&case, &life, |step: &LifeStep| {
+        if printed.is_ok() && step.time > 0.0 {
+            let depths: Vec<String> = step
+                .contacts
+                .iter()
+                .map(|c| format!("{:.3e}", c.tube_depth))
+                .collect();
+            printed = outln!(
+                "  {:>10.4} years  tube depth (m) {}",
+                step.time / YEAR,
+                depths.join(" ")
+            );
+        }
+    })
+    .map_err(|e| Failure::input(e.in_file(path)))?;
+    printed?;
+    write(&dir, &results, life.criterion)?;
+    if plots {
+        draw(&dir.join("life.png"), &case.title, &results, life.criterion)
+            .map_err(|e| Failure::failed(format!("{}: {e}", dir.join("life.png").display())))?;
+    }
+    for (k, name) in results.contacts.iter().enumerate() {
+        let last = &results.steps[results.steps.len() - 1].contacts[k];
+        let reach = |t: Option<f64>| t.map_or_else(|| "not reached".into(), |t| format!("{:.3} years", t / YEAR));
+        outln!(
+            "{name}: tube depth {:.4e} m (fixed gap {:.4e} m), support {:.4e} m; criterion {} (fixed gap {})",
+            last.tube_depth,
+            last.tube_depth_fixed_gap,
+            last.support_depth,
+            reach(results.time_to_criterion[k]),
+            reach(results.time_to_criterion_fixed_gap[k])
+        )?;
+    }
+    outln!(
+        "{} life steps, {} windows, {:.1} s; wrote {}",
+        results.steps.len() - 1,
+        results.windows,
+        results.wall_time,
+        dir.display()
+    )?;
+    match &results.end {
+        LifeEnd::Completed => Ok(()),
+        LifeEnd::StepLimit => Err(Failure::failed(format!(
+            "{}: life: the target was not reached in max_steps = {} life steps: raise life.max_steps or life.max_depth_change (results so far written)",
+            path.display(),
+            life.max_steps
+        ))),
+        LifeEnd::ScarLimit {
+            contact,
+            time,
+            message,
+        } => Err(Failure::failed(format!(
+            "{}: life: at {:.4} years the scar of contact '{contact}' reached the limit of its geometry ({message}); results so far written",
+            path.display(),
+            time / YEAR
+        ))),
+        LifeEnd::Diverged {
+            window,
+            time,
+            step,
+            contact,
+        } => Err(Failure::failed(format!(
+            "{}: life: window {window} (at {:.4} years) diverged at step {step}{}; results so far written",
+            path.display(),
+            time / YEAR,
+            contact
+                .as_ref()
+                .map(|c| format!(", contact '{c}'"))
+                .unwrap_or_default()
+        ))),
+    }
+}
+
+fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Failure> {
+    let put = |name: &str, text: String| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).map_err(|e| Failure::failed(format!("{}: {e}", p.display())))
+    };
+    let mut csv = String::from("time_years");
+    for name in &r.contacts {
+        for col in [
+            "wear_work_rate",
+            "tube_volume",
+            "support_volume",
+            "tube_depth",
+            "support_depth",
+            "clearance_increase",
+            "tube_depth_fixed_gap",
+        ] {
+            let _ = write!(csv, ",{name}.{col}");
+        }
+    }
+    csv.push('\n');
+    for s in &r.steps {
+        let _ = write!(csv, "{:e}", s.time / YEAR);
+        for c in &s.contacts {
+            let _ = write!(
+                csv,
+                ",{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+                c.wear_work_rate,
+                c.tube_volume,
+                c.support_volume,
+                c.tube_depth,
+                c.support_depth,
+                c.clearance_increase,
+                c.tube_depth_fixed_gap
+            );
+        }
+        csv.push('\n');
+    }
+    put("life.csv", csv)?;
+    let mut scars = String::from("contact,kind,bin,angle_deg,clearance_increase,tube_depth\n");
+    for s in &r.scars {
+        let n = s.clearance_increase.len();
+        for (b, (a, t)) in s.clearance_increase.iter().zip(&s.tube_depth).enumerate() {
+            let angle = if s.kind == "hole" {
+                format!("{}", (b as f64 + 0.5) * 360.0 / n as f64)
+            } else {
+                String::new()
+            };
+            let _ = writeln!(scars, "{},{},{b},{angle},{a:e},{t:e}", s.contact, s.kind);
+        }
+    }
+    put("scars.csv", scars)?;
+    let json = serde_json::json!({
+        "criterion_depth": criterion,
+        "results": r,
+    });
+    put(
+        "life.json",
+        serde_json::to_string_pretty(&json).unwrap_or_default() + "\n",
+    )
+}
+
+fn draw(path: &Path, title: &str, r: &LifeResults, criterion: Option<f64>) -> Result<(), String> {
+    let years: Vec<f64> = r.steps.iter().map(|s| s.time / YEAR).collect();
+    let columns: Vec<(Vec<f64>, Vec<f64>)> = (0..r.contacts.len())
+        .map(|k| {
+            (
+                r.steps.iter().map(|s| s.contacts[k].tube_depth).collect(),
+                r.steps
+                    .iter()
+                    .map(|s| s.contacts[k].tube_depth_fixed_gap)
+                    .collect(),
+            )
+        })
+        .collect();
+    let level: Vec<f64> = criterion.map_or_else(Vec::new, |c| vec![c; years.len()]);
+    let panels: Vec<(String, Vec<Series>)> = r
+        .contacts
+        .iter()
+        .zip(&columns)
+        .map(|(name, (coupled, fixed))| {
+            let mut s = vec![
+                Series {
+                    label: "scar fed back".into(),
+                    x: &years,
+                    y: coupled,
+                },
+                Series {
+                    label: "fixed gap".into(),
+                    x: &years,
+                    y: fixed,
+                },
+            ];
+            if !level.is_empty() {
+                s.push(Series {
+                    label: "criterion".into(),
+                    x: &years,
+                    y: &level,
+                });
+            }
+            (name.clone(), s)
+        })
+        .collect();
+    plot::panels_plot(
+        path,
+        &format!("{title}: tube wear depth"),
+        "service time (years)",
+        "depth (m)",
+        &panels,
+    )
+}

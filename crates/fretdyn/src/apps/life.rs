@@ -1,0 +1,617 @@
+//! Service life (THEORY §14.5): the wear depth of each contact over years, with the scar fed
+//! back into the obstacle's geometry.
+//!
+//! The vibration is simulated over a representative window (the case's `[time]` and
+//! `[statistics]` window), from the case's initial state, on the obstacles worn so far. Each
+//! contact's wear work rate `W` of the window and where it was done ([`WearMap`]) drive its
+//! wear laws over a life step `[t, t + Δt]` at constant `W`: the tube's and the support's
+//! volumes grow by `ΔV = ∫ V̇(W, τ) dτ`, spread over the bins of the map in the proportions of
+//! the window's work; the scar geometry turns each volume into a depth ([`crate::wear`]). The
+//! obstacle then recedes by the tube's plus the support's depth in the direction the scar
+//! faces ([`crate::contact::scar`]) and the next window is simulated, until the target time.
+//!
+//! The life step is the longest (up to the target) over which no contact's depth (tube plus
+//! support, where it is deepest) grows by more than `max_depth_change × max(g₀ + D, d_res)`,
+//! `g₀` the contact's clearance at rest, `D` its depth so far and `d_res` the depth
+//! resolution; it is found by bisection, the depth being monotone in `Δt`. Halving
+//! `max_depth_change` shows the convergence (docs/WEAR.md).
+//!
+//! The same windows give the fixed-gap extrapolation (the first window's rates kept for the
+//! whole life, as a post-processing of one run does) beside the coupled result.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::case::Case;
+use crate::contact::scar::{AngularProfile, ObstacleWear};
+use crate::error::{Error, Result};
+use crate::integrator::simulation::{Simulation, Termination};
+use crate::model::Model;
+use crate::results::wear_map::WearMap;
+use crate::wear::ContactWear;
+
+/// Seconds in a year (365.25 days).
+pub const YEAR: f64 = 365.25 * 86_400.0;
+
+/// The `[life]` section (THEORY §14.5).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LifeSettings {
+    /// Service time to reach, s.
+    pub target: f64,
+    /// Largest growth of a contact's depth in one life step, as a fraction of
+    /// `max(g₀ + D, depth_resolution)`.
+    pub max_depth_change: f64,
+    /// Depth below which the relative limit does not apply, m.
+    pub depth_resolution: f64,
+    /// The tube's plugging depth, m (time to reach it reported), if any.
+    pub criterion: Option<f64>,
+    /// Feed the scars back into the obstacles (`false`: the fixed-gap extrapolation only).
+    pub feedback: bool,
+    /// Angular bins of a hole's scar profile.
+    pub angular_bins: usize,
+    /// Largest number of life steps.
+    pub max_steps: usize,
+}
+
+impl LifeSettings {
+    /// Checks the numbers; `field` is the section's name in messages.
+    pub fn validate(&self, field: &str) -> Result<()> {
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if !positive(self.target) {
+            return Err(Error::invalid(
+                format!("{field}.target_years"),
+                "must be a service time > 0 in years",
+            ));
+        }
+        if !(positive(self.max_depth_change) && self.max_depth_change <= 1.0) {
+            return Err(Error::invalid(
+                format!("{field}.max_depth_change"),
+                format!(
+                    "must be a fraction in (0, 1] (got {}); 0.1 is a good start, halve it to check convergence",
+                    self.max_depth_change
+                ),
+            ));
+        }
+        if !positive(self.depth_resolution) {
+            return Err(Error::invalid(
+                format!("{field}.depth_resolution"),
+                "must be a depth > 0 in m (e.g. 1e-6)",
+            ));
+        }
+        if let Some(c) = self.criterion
+            && !positive(c)
+        {
+            return Err(Error::invalid(
+                format!("{field}.criterion_depth"),
+                "must be a depth > 0 in m (e.g. 40 % of the tube wall)",
+            ));
+        }
+        if self.angular_bins < 4 {
+            return Err(Error::invalid(
+                format!("{field}.angular_bins"),
+                "must be at least 4 (72 = 5° bins by default)",
+            ));
+        }
+        if self.max_steps == 0 {
+            return Err(Error::invalid(
+                format!("{field}.max_steps"),
+                "must be at least 1",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One contact at the end of a life step.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ContactLife {
+    /// Wear work rate of the window that drove the step, W.
+    pub wear_work_rate: f64,
+    /// Wear volume of the tube so far, m³.
+    pub tube_volume: f64,
+    /// Wear volume of the support so far, m³.
+    pub support_volume: f64,
+    /// Depth of the tube's scar (the deepest, for bars: the deeper side), m.
+    pub tube_depth: f64,
+    /// Depth of the support's scar, m.
+    pub support_depth: f64,
+    /// The clearance the scars add where they are deepest (tube plus support), m.
+    pub clearance_increase: f64,
+    /// The tube's depth by the fixed-gap extrapolation of the first window, m.
+    pub tube_depth_fixed_gap: f64,
+}
+
+/// The state after one life step.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LifeStep {
+    /// Service time at the end of the step, s.
+    pub time: f64,
+    /// Per contact (the contacts with `wear`, in the case's order).
+    pub contacts: Vec<ContactLife>,
+}
+
+/// How a service-life computation ended.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum LifeEnd {
+    /// The target time was reached.
+    Completed,
+    /// A window diverged: the life stops at the service time it started from.
+    Diverged {
+        /// The window (from 0).
+        window: usize,
+        /// Service time, s.
+        time: f64,
+        /// Step of the window and the contact where it diverged.
+        step: u64,
+        /// The contact, if one was named.
+        contact: Option<String>,
+    },
+    /// `max_steps` life steps did not reach the target.
+    StepLimit,
+    /// A scar reached the limit of its geometry (e.g. a tube's depth its radius): the life
+    /// stops at the service time it reached.
+    ScarLimit {
+        /// The contact.
+        contact: String,
+        /// Service time, s.
+        time: f64,
+        /// What the geometry says.
+        message: String,
+    },
+}
+
+/// A scar's final state, for the scar profiles.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ScarProfile {
+    /// The contact.
+    pub contact: String,
+    /// `plane`, `bars` (values for the `+n`, `−n` sides) or `hole` (values per angular bin,
+    /// bin `k` centred on `(k + ½) 360°/N` in the hole's axes).
+    pub kind: &'static str,
+    /// Added clearance (tube plus support depth) per bin, m.
+    pub clearance_increase: Vec<f64>,
+    /// Tube depth per bin, m.
+    pub tube_depth: Vec<f64>,
+}
+
+/// The result of [`service_life`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LifeResults {
+    /// Names of the wearing contacts.
+    pub contacts: Vec<String>,
+    /// Clearance at rest of each wearing contact, m.
+    pub clearances: Vec<f64>,
+    /// The state at t = 0 and after every life step.
+    pub steps: Vec<LifeStep>,
+    /// Time at which each contact's tube depth reaches the criterion, s (`None`: not reached).
+    pub time_to_criterion: Vec<Option<f64>>,
+    /// Same, by the fixed-gap extrapolation.
+    pub time_to_criterion_fixed_gap: Vec<Option<f64>>,
+    /// Final scar profiles.
+    pub scars: Vec<ScarProfile>,
+    /// How it ended.
+    pub end: LifeEnd,
+    /// Windows simulated.
+    pub windows: usize,
+    /// Wall-clock time, s.
+    pub wall_time: f64,
+}
+
+/// Cumulative wear of one contact, per bin of its [`WearMap`].
+#[derive(Debug, Clone)]
+struct Worn {
+    /// Tube volume per bin, m³.
+    tube: Vec<f64>,
+    /// Support volume per bin, m³.
+    support: Vec<f64>,
+}
+
+/// The depths of a contact's scar(s) from its volumes.
+struct Depths {
+    /// Tube depth per bin (what faces each direction), m.
+    tube: Vec<f64>,
+    /// Added clearance per bin, m.
+    added: Vec<f64>,
+    /// Support depth where deepest, m.
+    support_max: f64,
+}
+
+impl Worn {
+    fn new(bins: usize) -> Self {
+        Self {
+            tube: vec![0.0; bins],
+            support: vec![0.0; bins],
+        }
+    }
+
+    /// Depths from the volumes (THEORY §14.4): a plane's or a side's scar from its own
+    /// volumes; around a hole, the scar's depth from the whole volume, spread over the bins
+    /// in proportion to each bin's volume (the deepest bin takes the full depth), or all
+    /// around for a uniform scar.
+    fn depths(&self, wear: &ContactWear, field: &str) -> Result<Depths> {
+        let n = self.tube.len();
+        if n <= 2 {
+            let mut d = Depths {
+                tube: vec![0.0; n],
+                added: vec![0.0; n],
+                support_max: 0.0,
+            };
+            for b in 0..n {
+                let t = wear.scar.tube_depth(self.tube[b]).map_err(|e| at(e, field))?;
+                let s = wear
+                    .scar
+                    .support_depth(self.support[b])
+                    .map_err(|e| at(e, field))?;
+                d.tube[b] = t;
+                d.added[b] = t + s;
+                d.support_max = d.support_max.max(s);
+            }
+            return Ok(d);
+        }
+        let (vt, vs): (f64, f64) = (self.tube.iter().sum(), self.support.iter().sum());
+        let t = wear.scar.tube_depth(vt).map_err(|e| at(e, field))?;
+        let s = wear.scar.support_depth(vs).map_err(|e| at(e, field))?;
+        let shape: Vec<f64> = if wear.scar.is_uniform_around() {
+            vec![1.0; n]
+        } else {
+            let total: Vec<f64> = self
+                .tube
+                .iter()
+                .zip(&self.support)
+                .map(|(a, b)| a + b)
+                .collect();
+            let max = total.iter().copied().fold(0.0, f64::max);
+            if max > 0.0 {
+                total.iter().map(|v| v / max).collect()
+            } else {
+                vec![0.0; n]
+            }
+        };
+        Ok(Depths {
+            tube: shape.iter().map(|f| f * t).collect(),
+            added: shape.iter().map(|f| f * (t + s)).collect(),
+            support_max: s,
+        })
+    }
+}
+
+fn at(e: Error, field: &str) -> Error {
+    match e {
+        Error::Invalid { field: f, message } => Error::invalid(format!("{field}.{f}"), message),
+        other => other,
+    }
+}
+
+/// The obstacle's wear for the added clearance per bin.
+fn obstacle_wear(added: &[f64]) -> ObstacleWear {
+    match added.len() {
+        1 => ObstacleWear::Uniform(added[0]),
+        2 => ObstacleWear::Sides {
+            positive: added[0],
+            negative: added[1],
+        },
+        // the bins' depths are finite and ≥ 0 by construction
+        _ => ObstacleWear::Angular(
+            AngularProfile::new(added.to_vec()).unwrap_or_else(|| {
+                AngularProfile::new(vec![0.0; added.len()]).expect("zero profile")
+            }),
+        ),
+    }
+}
+
+/// One window's wear work rate and its split over the bins, per wearing contact.
+struct Window {
+    rates: Vec<f64>,
+    fractions: Vec<Vec<f64>>,
+}
+
+/// Runs one window of `model`, tracking where the friction work is done.
+fn window(
+    case: &Case,
+    model: &Model,
+    wearing: &[usize],
+    bins: usize,
+) -> Result<std::result::Result<Window, (u64, Option<String>)>> {
+    let settings = &case.settings;
+    let mut sim = Simulation::with_recorder(model, settings, 1)?;
+    sim.track_wear(bins);
+    let total = settings.steps;
+    let mut termination = Termination::Completed;
+    while sim.steps_done() < total {
+        if let Err(d) = sim.step() {
+            termination = d.into_termination(model);
+            break;
+        }
+        if sim.recorder().is_full() {
+            sim.recorder_mut().clear();
+        }
+        if sim.steps_done() % 1024 == 0 {
+            let statistics = sim.statistics_mut();
+            statistics.impacts.clear();
+            statistics.blocks.clear();
+        }
+    }
+    let map: WearMap = sim.wear_map().cloned().expect("tracked");
+    let results = sim.finish(0.0, termination);
+    if let Termination::Diverged { step, contact, .. } = results.termination {
+        return Ok(Err((step, contact)));
+    }
+    let mut rates = Vec::with_capacity(wearing.len());
+    let mut fractions = Vec::with_capacity(wearing.len());
+    for &k in wearing {
+        rates.push(results.contacts[k].wear_work_rate);
+        let work = map.work(k);
+        let sum: f64 = work.iter().sum();
+        fractions.push(if sum > 0.0 {
+            work.iter().map(|w| w / sum).collect()
+        } else {
+            vec![0.0; work.len()]
+        });
+    }
+    Ok(Ok(Window { rates, fractions }))
+}
+
+/// The volumes after `[t0, t1]` at the window's rates.
+fn advanced(worn: &Worn, wear: &ContactWear, rate: f64, fractions: &[f64], t0: f64, t1: f64) -> Worn {
+    let dvt = wear.tube.volume_increment(rate, t0, t1);
+    let dvs = wear.support.volume_increment(rate, t0, t1);
+    Worn {
+        tube: worn
+            .tube
+            .iter()
+            .zip(fractions)
+            .map(|(v, f)| v + f * dvt)
+            .collect(),
+        support: worn
+            .support
+            .iter()
+            .zip(fractions)
+            .map(|(v, f)| v + f * dvs)
+            .collect(),
+    }
+}
+
+fn deepest(d: &[f64]) -> f64 {
+    d.iter().copied().fold(0.0, f64::max)
+}
+
+/// The service life of `case` with its `[life]` settings (THEORY §14.5). `observer` sees
+/// each step as it is done.
+pub fn service_life(
+    case: &Case,
+    life: &LifeSettings,
+    mut observer: impl FnMut(&LifeStep),
+) -> Result<LifeResults> {
+    life.validate("life")?;
+    let start = Instant::now();
+    let model = &case.model;
+    let wearing: Vec<usize> = (0..model.contacts.len())
+        .filter(|&k| model.wear.get(k).is_some_and(|w| w.is_some()))
+        .collect();
+    if wearing.is_empty() {
+        return Err(Error::invalid(
+            "life",
+            "no contact has a wear law: give `wear = { tube = …, support = …, scar = … }` in the [[contacts]] that wear (docs/WEAR.md)",
+        ));
+    }
+    let wear: Vec<&ContactWear> = wearing
+        .iter()
+        .map(|&k| model.wear[k].as_ref().expect("wearing"))
+        .collect();
+    let fields: Vec<String> = wearing.iter().map(|k| format!("contacts[{k}].wear")).collect();
+    let names: Vec<String> = wearing
+        .iter()
+        .map(|&k| model.contacts[k].name.clone())
+        .collect();
+    let clearances: Vec<f64> = wearing
+        .iter()
+        .map(|&k| {
+            let c = &model.contacts[k];
+            let x = model.basis.points[c.point].coords;
+            (-c.frame(&x, 0.0).penetration).max(0.0)
+        })
+        .collect();
+    let bins: Vec<usize> = wearing
+        .iter()
+        .map(|&k| WearMap::new(model, life.angular_bins).work(k).len())
+        .collect();
+    let mut worn: Vec<Worn> = bins.iter().map(|&b| Worn::new(b)).collect();
+    let mut fixed: Vec<Worn> = worn.clone();
+    let zero = ContactLife {
+        wear_work_rate: 0.0,
+        tube_volume: 0.0,
+        support_volume: 0.0,
+        tube_depth: 0.0,
+        support_depth: 0.0,
+        clearance_increase: 0.0,
+        tube_depth_fixed_gap: 0.0,
+    };
+    let mut steps = vec![LifeStep {
+        time: 0.0,
+        contacts: vec![zero; wearing.len()],
+    }];
+    observer(&steps[0]);
+    let mut time_to_criterion = vec![None; wearing.len()];
+    let mut time_fixed = vec![None; wearing.len()];
+    let mut first: Option<Window> = None;
+    let mut current = model.clone();
+    let mut t = 0.0;
+    let mut windows = 0;
+    let mut end = LifeEnd::StepLimit;
+    for _ in 0..life.max_steps {
+        if t >= life.target {
+            end = LifeEnd::Completed;
+            break;
+        }
+        // the window on the obstacles worn so far (the first one only without feedback)
+        let w = if life.feedback || first.is_none() {
+            windows += 1;
+            match window(case, &current, &wearing, life.angular_bins)? {
+                Ok(w) => w,
+                Err((step, contact)) => {
+                    end = LifeEnd::Diverged {
+                        window: windows - 1,
+                        time: t,
+                        step,
+                        contact,
+                    };
+                    break;
+                }
+            }
+        } else {
+            let f = first.as_ref().expect("first window");
+            Window {
+                rates: f.rates.clone(),
+                fractions: f.fractions.clone(),
+            }
+        };
+        let w0 = first.get_or_insert_with(|| Window {
+            rates: w.rates.clone(),
+            fractions: w.fractions.clone(),
+        });
+        // the longest step within the depth limit at every contact
+        let mut dt = life.target - t;
+        for (i, wear) in wear.iter().enumerate() {
+            let now = deepest(&worn[i].depths(wear, &fields[i])?.added);
+            let limit = life.max_depth_change * (clearances[i] + now).max(life.depth_resolution);
+            // beyond the geometry's limit counts as too much growth
+            let grown = |h: f64| -> f64 {
+                let next = advanced(&worn[i], wear, w.rates[i], &w.fractions[i], t, t + h);
+                next.depths(wear, &fields[i])
+                    .map_or(f64::INFINITY, |d| deepest(&d.added) - now)
+            };
+            if grown(dt) > limit {
+                let (mut lo, mut hi) = (0.0, dt);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    if grown(mid) > limit {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                dt = lo.max(f64::MIN_POSITIVE);
+            }
+        }
+        let t1 = if life.target - t - dt <= 1e-12 * life.target {
+            life.target
+        } else {
+            t + dt
+        };
+        // every contact's next state, or the first scar beyond its geometry
+        let mut next = Vec::with_capacity(wearing.len());
+        for (i, wear) in wear.iter().enumerate() {
+            let a = advanced(&worn[i], wear, w.rates[i], &w.fractions[i], t, t1);
+            let f = advanced(&fixed[i], wear, w0.rates[i], &w0.fractions[i], t, t1);
+            match (a.depths(wear, &fields[i]), f.depths(wear, &fields[i])) {
+                (Ok(d), Ok(df)) if t1 - t > 1e-12 * life.target => next.push((a, f, d, df)),
+                (Err(e), _) | (Ok(_), Err(e)) => {
+                    end = LifeEnd::ScarLimit {
+                        contact: names[i].clone(),
+                        time: t,
+                        message: e.to_string(),
+                    };
+                    break;
+                }
+                _ => {
+                    end = LifeEnd::ScarLimit {
+                        contact: names[i].clone(),
+                        time: t,
+                        message: "the scar's depth no longer grows within its geometry".into(),
+                    };
+                    break;
+                }
+            }
+        }
+        if next.len() < wearing.len() {
+            break;
+        }
+        let mut state = Vec::with_capacity(wearing.len());
+        for (i, (wear, (a, f, d, df))) in wear.iter().zip(next).enumerate() {
+            let before = std::mem::replace(&mut worn[i], a);
+            let fixed_before = std::mem::replace(&mut fixed[i], f);
+            if let Some(c) = life.criterion {
+                if time_to_criterion[i].is_none() && deepest(&d.tube) >= c {
+                    time_to_criterion[i] = Some(crossing(t, t1, c, |h| {
+                        let next = advanced(&before, wear, w.rates[i], &w.fractions[i], t, h);
+                        next.depths(wear, &fields[i]).map(|d| deepest(&d.tube))
+                    })?);
+                }
+                if time_fixed[i].is_none() && deepest(&df.tube) >= c {
+                    time_fixed[i] = Some(crossing(t, t1, c, |h| {
+                        let next = advanced(&fixed_before, wear, w0.rates[i], &w0.fractions[i], t, h);
+                        next.depths(wear, &fields[i]).map(|d| deepest(&d.tube))
+                    })?);
+                }
+            }
+            state.push(ContactLife {
+                wear_work_rate: w.rates[i],
+                tube_volume: worn[i].tube.iter().sum(),
+                support_volume: worn[i].support.iter().sum(),
+                tube_depth: deepest(&d.tube),
+                support_depth: d.support_max,
+                clearance_increase: deepest(&d.added),
+                tube_depth_fixed_gap: deepest(&df.tube),
+            });
+            if life.feedback {
+                let k = wearing[i];
+                current.contacts[k].obstacle = model.contacts[k]
+                    .obstacle
+                    .worn(&obstacle_wear(&d.added), &fields[i])?;
+            }
+        }
+        t = t1;
+        steps.push(LifeStep {
+            time: t,
+            contacts: state,
+        });
+        observer(steps.last().expect("pushed"));
+    }
+    if t >= life.target && matches!(end, LifeEnd::StepLimit) {
+        end = LifeEnd::Completed;
+    }
+    let mut scars = Vec::with_capacity(wearing.len());
+    for (i, wear) in wear.iter().enumerate() {
+        let d = worn[i].depths(wear, &fields[i])?;
+        scars.push(ScarProfile {
+            contact: names[i].clone(),
+            kind: match d.added.len() {
+                1 => "plane",
+                2 => "bars",
+                _ => "hole",
+            },
+            clearance_increase: d.added,
+            tube_depth: d.tube,
+        });
+    }
+    Ok(LifeResults {
+        contacts: names,
+        clearances,
+        steps,
+        time_to_criterion,
+        time_to_criterion_fixed_gap: time_fixed,
+        scars,
+        end,
+        windows,
+        wall_time: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// The time in `[t0, t1]` at which `depth(t)` (increasing) reaches `c`, by bisection.
+fn crossing(t0: f64, t1: f64, c: f64, depth: impl Fn(f64) -> Result<f64>) -> Result<f64> {
+    let (mut lo, mut hi) = (t0, t1);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if depth(mid)? >= c {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(hi)
+}

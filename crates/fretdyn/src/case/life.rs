@@ -1,0 +1,85 @@
+//! `[life]`: the service-life computation of `fretdyn life` (THEORY §14.5, docs/WEAR.md).
+
+use serde::Deserialize;
+
+use super::TubeModel;
+use crate::apps::life::{LifeSettings, YEAR};
+use crate::error::{Error, Result};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct LifeSection {
+    /// Service time to reach, years (of operation).
+    target_years: f64,
+    #[serde(default = "default_change")]
+    max_depth_change: f64,
+    #[serde(default = "default_resolution")]
+    depth_resolution: f64,
+    /// The tube's plugging depth, m.
+    criterion_depth: Option<f64>,
+    /// Or as a fraction of a tube structure's wall thickness.
+    criterion_wall_fraction: Option<f64>,
+    #[serde(default = "yes")]
+    feedback: bool,
+    #[serde(default = "default_bins")]
+    angular_bins: usize,
+    #[serde(default = "default_steps")]
+    max_steps: usize,
+}
+
+fn default_change() -> f64 {
+    0.1
+}
+fn default_resolution() -> f64 {
+    1e-6
+}
+fn yes() -> bool {
+    true
+}
+fn default_bins() -> usize {
+    72
+}
+fn default_steps() -> usize {
+    1000
+}
+
+impl LifeSection {
+    pub(super) fn build(&self, tube: Option<&TubeModel>) -> Result<LifeSettings> {
+        let criterion = match (self.criterion_depth, self.criterion_wall_fraction) {
+            (Some(_), Some(_)) => {
+                return Err(Error::invalid(
+                    "life.criterion_wall_fraction",
+                    "give criterion_depth (m) or criterion_wall_fraction, not both",
+                ));
+            }
+            (Some(d), None) => Some(d),
+            (None, Some(f)) => {
+                if !(f.is_finite() && f > 0.0 && f <= 1.0) {
+                    return Err(Error::invalid(
+                        "life.criterion_wall_fraction",
+                        format!("must be a fraction of the wall in (0, 1] (got {f}), e.g. 0.4"),
+                    ));
+                }
+                let tube = tube.ok_or_else(|| {
+                    Error::invalid(
+                        "life.criterion_wall_fraction",
+                        "needs a type = \"tube\" structure (its wall_thickness): give criterion_depth in m instead",
+                    )
+                })?;
+                Some(f * tube.structure.beam.tube.section.wall_thickness)
+            }
+            (None, None) => None,
+        };
+        let settings = LifeSettings {
+            target: self.target_years * YEAR,
+            max_depth_change: self.max_depth_change,
+            depth_resolution: self.depth_resolution,
+            criterion,
+            feedback: self.feedback,
+            angular_bins: self.angular_bins,
+            max_steps: self.max_steps,
+        };
+        settings.validate("life")?;
+        Ok(settings)
+    }
+}
