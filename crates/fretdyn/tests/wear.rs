@@ -777,6 +777,10 @@ fn case_file_wear_table_is_read() {
             tilt: 0.0
         }
     );
+    // the same as a sub-table of the contact (docs/WEAR.md)
+    let sub = case_with(PLANE, "", BAR_WEAR).replace(&format!("wear = {BAR_WEAR}"), "")
+        + "[contacts.wear]\ntube = { law = \"archard\", coefficient = 20e-15 }\nsupport = { law = \"archard\", coefficient = 10e-15 }\nscar = { type = \"flat_bar\", width = 0.0254, tilt_deg = 0.0, tube_radius = 0.0095 }\n";
+    assert_eq!(parse(&sub).unwrap().model.wear, case.model.wear);
     // a drilled hole takes the circle's clearance; the radius from the scar table
     let hole = r#"{ tube = { law = "decaying", a = 1e-14, b = 1.2, s = 0.3, n = 1e-8 }, support = { law = "table", work_rate = [0.0, 0.1], volume_rate = [0.0, 1e-15] }, scar = { type = "drilled_hole", thickness = 0.03, shape = "crescent", tube_radius = 0.0095 } }"#;
     let case = parse(&case_with(CIRCLE, "", hole)).unwrap();
