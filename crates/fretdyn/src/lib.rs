@@ -22,7 +22,9 @@
 //! 6. [`integrator`] — central differences, the stability limit and the step loop
 //!    (THEORY §2–§4);
 //! 7. [`results`] — recorder, statistics and energy balance, `results.npz`, `summary.json`,
-//!    streamed runs and checkpoints (THEORY §5, §11).
+//!    streamed runs and checkpoints (THEORY §5, §11);
+//! 8. [`wear`] — after the run: wear laws and scar geometries, from the wear work rate to the
+//!    depth of the scars (THEORY §14, `docs/WEAR.md`).
 //!
 //! The [`apps`] (parameter studies, verification cases, the benchmark) run cases and add no
 //! physics. [`Error`] is the one error type of the crate.
@@ -54,6 +56,8 @@ pub mod model;
 pub mod integrator;
 
 pub mod results;
+
+pub mod wear;
 
 pub mod apps;
 

@@ -62,6 +62,10 @@ pub struct Model {
     pub base_acceleration: Option<BaseAcceleration>,
     /// Fluid-elastic forces of the flow, on the modes (THEORY §13).
     pub fluid_elastic: Option<crate::loads::fluid_elastic::FluidElastic>,
+    /// The wear laws and scar geometry of each contact that has them (`docs/WEAR.md`,
+    /// THEORY §14): one per contact as a case file builds them, or empty; used after the
+    /// run, never in the time-step loop. See [`Model::contact_wear`].
+    pub wear: Vec<Option<crate::wear::ContactWear>>,
     /// Initial state.
     pub initial: InitialState,
 }
@@ -79,6 +83,7 @@ impl Model {
             turbulence: Vec::new(),
             base_acceleration: None,
             fluid_elastic: None,
+            wear: Vec::new(),
             initial: InitialState {
                 q: vec![0.0; p],
                 qdot: vec![0.0; p],
@@ -101,6 +106,11 @@ impl Model {
         });
         model.coordinates = Coordinates::Physical(Box::new(matrices));
         model
+    }
+
+    /// The wear laws and scar geometry of contact `k`, if it has them.
+    pub fn contact_wear(&self, k: usize) -> Option<&crate::wear::ContactWear> {
+        self.wear.get(k).and_then(Option::as_ref)
     }
 
     /// Checks the basis and that every index and vector length is consistent.
@@ -129,6 +139,21 @@ impl Model {
         }
         if let Some(fe) = &self.fluid_elastic {
             fe.validate(p)?;
+        }
+        if self.wear.len() > self.contacts.len() {
+            return Err(Error::invalid(
+                "contacts",
+                format!(
+                    "{} wear entries for {} contacts: give at most one per contact",
+                    self.wear.len(),
+                    self.contacts.len()
+                ),
+            ));
+        }
+        for (k, w) in self.wear.iter().enumerate() {
+            if let Some(w) = w {
+                w.validate(&format!("contacts[{k}].wear"))?;
+            }
         }
         let np = self.basis.points.len();
         for (k, c) in self.contacts.iter().enumerate() {

@@ -23,6 +23,8 @@ pub(super) struct ContactSection {
     motion: Option<MotionInput>,
     normal: NormalInput,
     friction: FrictionInput,
+    /// Wear laws and scar geometry (docs/WEAR.md).
+    wear: Option<super::wear::WearInput>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -248,6 +250,11 @@ impl CaseFile {
                 contact.motion = m.motion();
             }
             contact.validate(&model.basis.points[pt], &field)?;
+            let wear = c
+                .wear
+                .as_ref()
+                .map(|w| w.build(c.radius, &c.obstacle, &field));
+            model.wear.push(wear.transpose()?);
             model.contacts.push(contact);
         }
         Ok(())

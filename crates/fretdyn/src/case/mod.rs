@@ -6,7 +6,7 @@
 //! The schema is split by section, each file holding its sections' types and the build of
 //! the model from them:
 //! - `structure`: `[structure]` and `[initial]`;
-//! - `contacts`: `[[contacts]]`;
+//! - `contacts`: `[[contacts]]` (their `wear` tables in `wear`);
 //! - `loads`: `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]`, `[[turbulence]]`,
 //!   `[base_excitation]`;
 //! - `flow`: `[flow]` and its `[[flow.zones]]`;
@@ -22,6 +22,7 @@ mod life;
 mod loads;
 mod settings;
 mod structure;
+mod wear;
 
 pub use structure::TubeModel;
 

@@ -60,7 +60,7 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
             "simulated_time": results.steps as f64 * results.dt,
             "samples": results.steps / case.settings.output_every + 1,
         },
-        "contacts": results.contacts,
+        "contacts": contacts_with_wear(case, results),
         "contact_geometry": case.model.contacts.iter().map(|c| json!({
             "name": c.name,
             "obstacle": c.obstacle.kind(),
@@ -79,6 +79,23 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
         },
         "case": case.echo,
     })
+}
+
+/// The per-contact statistics; a contact with `wear` (docs/WEAR.md) also gets
+/// `tube_volume_rate` and `support_volume_rate`, m³/s, its laws at the run's wear work rate
+/// and service time 0 (THEORY §14).
+fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
+    let mut contacts = json!(results.contacts);
+    if let Some(list) = contacts.as_array_mut() {
+        for (k, (entry, stats)) in list.iter_mut().zip(&results.contacts).enumerate() {
+            if let (Some(w), Some(map)) = (case.model.contact_wear(k), entry.as_object_mut()) {
+                let (tube, support) = w.volume_rates(stats.wear_work_rate, 0.0);
+                map.insert("tube_volume_rate".into(), json!(tube));
+                map.insert("support_volume_rate".into(), json!(support));
+            }
+        }
+    }
+    contacts
 }
 
 /// Writes `summary.json` in `dir`.
