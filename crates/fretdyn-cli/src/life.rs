@@ -71,7 +71,12 @@ pub fn main(path: &Path, output: Option<PathBuf>, plots: bool) -> Result<(), Fai
     }
     for (k, name) in results.contacts.iter().enumerate() {
         let last = &results.steps[results.steps.len() - 1].contacts[k];
-        let reach = |t: Option<f64>| t.map_or_else(|| "not reached".into(), |t| format!("{:.3} years", t / YEAR));
+        let reach = |t: Option<f64>| {
+            t.map_or_else(
+                || "not reached".into(),
+                |t| format!("{:.3} years", t / YEAR),
+            )
+        };
         outln!(
             "{name}: tube depth {:.4e} m (fixed gap {:.4e} m), support {:.4e} m; criterion {} (fixed gap {})",
             last.tube_depth,
@@ -90,6 +95,10 @@ pub fn main(path: &Path, output: Option<PathBuf>, plots: bool) -> Result<(), Fai
     )?;
     match &results.end {
         LifeEnd::Completed => Ok(()),
+        LifeEnd::Perforated { contact, time } => outln!(
+            "the tube at '{contact}' is worn through its wall at {:.4} years: the life stops there",
+            time / YEAR
+        ),
         LifeEnd::StepLimit => Err(Failure::failed(format!(
             "{}: life: the target was not reached in max_steps = {} life steps: raise life.max_steps or life.max_depth_change (results so far written)",
             path.display(),

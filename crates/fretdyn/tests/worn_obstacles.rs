@@ -13,18 +13,16 @@ use nalgebra::{Vector2, Vector3};
 
 #[test]
 fn a_worn_plane_recedes_by_its_depth_and_bars_by_their_sides() {
-    let plane = Obstacle::Plane(
-        Plane::new(Vector3::zeros(), Vector3::z(), 1e-4, None, "p").unwrap(),
-    );
+    let plane =
+        Obstacle::Plane(Plane::new(Vector3::zeros(), Vector3::z(), 1e-4, None, "p").unwrap());
     let worn = plane.worn(&ObstacleWear::Uniform(3e-5), "p").unwrap();
     for z in [-2e-4, -1.3e-4, 0.0, 5e-5] {
         let x = Vector3::new(0.1, -0.2, z);
         let d = worn.frame(&x).penetration - plane.frame(&x).penetration;
         assert!((d + 3e-5).abs() < 1e-18, "{d}");
     }
-    let bars = Obstacle::BiPlane(
-        BiPlane::new(Vector3::zeros(), Vector3::y(), 1e-4, None, "b").unwrap(),
-    );
+    let bars =
+        Obstacle::BiPlane(BiPlane::new(Vector3::zeros(), Vector3::y(), 1e-4, None, "b").unwrap());
     let worn = bars
         .worn(
             &ObstacleWear::Sides {
@@ -44,8 +42,14 @@ fn a_worn_plane_recedes_by_its_depth_and_bars_by_their_sides() {
     let profile = ObstacleWear::Angular(AngularProfile::new(vec![0.0; 8]).unwrap());
     assert!(plane.worn(&profile, "contacts[0].wear").is_err());
     let hole = Obstacle::Circle(Circle::new(Vector3::zeros(), Vector3::x(), 2e-4, "h").unwrap());
-    let e = hole.worn(&ObstacleWear::Uniform(1e-5), "contacts[1].wear").unwrap_err();
-    assert!(e.to_string().starts_with("contacts[1].wear: a circle obstacle"), "{e}");
+    let e = hole
+        .worn(&ObstacleWear::Uniform(1e-5), "contacts[1].wear")
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("contacts[1].wear: a circle obstacle"),
+        "{e}"
+    );
     assert!(AngularProfile::new(vec![1e-5, f64::NAN]).is_none());
     assert!(AngularProfile::new(vec![1e-5, -1e-9]).is_none());
 }

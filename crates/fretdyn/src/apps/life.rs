@@ -29,7 +29,7 @@ use crate::error::{Error, Result};
 use crate::integrator::simulation::{Simulation, Termination};
 use crate::model::Model;
 use crate::results::wear_map::WearMap;
-use crate::wear::ContactWear;
+use crate::wear::{ContactWear, HoleScar, Scar, WearWork};
 
 /// Seconds in a year (365.25 days).
 pub const YEAR: f64 = 365.25 * 86_400.0;
@@ -46,6 +46,9 @@ pub struct LifeSettings {
     pub depth_resolution: f64,
     /// The tube's plugging depth, m (time to reach it reported), if any.
     pub criterion: Option<f64>,
+    /// The tube's wall thickness, m, if known (a tube structure): the life stops when a
+    /// tube's depth reaches it.
+    pub wall: Option<f64>,
     /// Feed the scars back into the obstacles (`false`: the fixed-gap extrapolation only).
     pub feedback: bool,
     /// Angular bins of a hole's scar profile.
@@ -106,7 +109,8 @@ impl LifeSettings {
 /// One contact at the end of a life step.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ContactLife {
-    /// Wear work rate of the window that drove the step, W.
+    /// Wear work rate of the window that drove the step (the law's work: friction or
+    /// normal), W.
     pub wear_work_rate: f64,
     /// Wear volume of the tube so far, m³.
     pub tube_volume: f64,
@@ -116,7 +120,8 @@ pub struct ContactLife {
     pub tube_depth: f64,
     /// Depth of the support's scar, m.
     pub support_depth: f64,
-    /// The clearance the scars add where they are deepest (tube plus support), m.
+    /// The clearance the scars add where they are deepest ([`Scar::approach`] of the two
+    /// volumes: how far tube and support came together), m.
     pub clearance_increase: f64,
     /// The tube's depth by the fixed-gap extrapolation of the first window, m.
     pub tube_depth_fixed_gap: f64,
@@ -150,6 +155,14 @@ pub enum LifeEnd {
     },
     /// `max_steps` life steps did not reach the target.
     StepLimit,
+    /// A tube's depth reached its wall thickness: the life stops there (a result, not an
+    /// error: the depth against time up to then is the answer).
+    Perforated {
+        /// The contact.
+        contact: String,
+        /// Service time at which the depth reached the wall, s.
+        time: f64,
+    },
     /// A scar reached the limit of its geometry (e.g. a tube's depth its radius): the life
     /// stops at the service time it reached.
     ScarLimit {
@@ -170,7 +183,7 @@ pub struct ScarProfile {
     /// `plane`, `bars` (values for the `+n`, `−n` sides) or `hole` (values per angular bin,
     /// bin `k` centred on `(k + ½) 360°/N` in the hole's axes).
     pub kind: &'static str,
-    /// Added clearance (tube plus support depth) per bin, m.
+    /// Added clearance (the approach of tube and support, [`Scar::approach`]) per bin, m.
     pub clearance_increase: Vec<f64>,
     /// Tube depth per bin, m.
     pub tube_depth: Vec<f64>,
@@ -239,13 +252,11 @@ impl Worn {
                 support_max: 0.0,
             };
             for b in 0..n {
-                let t = wear.scar.tube_depth(self.tube[b]).map_err(|e| at(e, field))?;
-                let s = wear
-                    .scar
-                    .support_depth(self.support[b])
-                    .map_err(|e| at(e, field))?;
+                let (vt, vs) = (self.tube[b], self.support[b]);
+                let t = wear.scar.tube_depth(vt).map_err(|e| at(e, field))?;
+                let s = wear.scar.support_depth(vs).map_err(|e| at(e, field))?;
                 d.tube[b] = t;
-                d.added[b] = t + s;
+                d.added[b] = wear.scar.approach(vt, vs).map_err(|e| at(e, field))?;
                 d.support_max = d.support_max.max(s);
             }
             return Ok(d);
@@ -253,7 +264,15 @@ impl Worn {
         let (vt, vs): (f64, f64) = (self.tube.iter().sum(), self.support.iter().sum());
         let t = wear.scar.tube_depth(vt).map_err(|e| at(e, field))?;
         let s = wear.scar.support_depth(vs).map_err(|e| at(e, field))?;
-        let shape: Vec<f64> = if wear.scar.is_uniform_around() {
+        let approach = wear.scar.approach(vt, vs).map_err(|e| at(e, field))?;
+        let uniform = matches!(
+            wear.scar,
+            Scar::DrilledHole {
+                shape: HoleScar::Uniform,
+                ..
+            }
+        );
+        let shape: Vec<f64> = if uniform {
             vec![1.0; n]
         } else {
             let total: Vec<f64> = self
@@ -271,7 +290,7 @@ impl Worn {
         };
         Ok(Depths {
             tube: shape.iter().map(|f| f * t).collect(),
-            added: shape.iter().map(|f| f * (t + s)).collect(),
+            added: shape.iter().map(|f| f * approach).collect(),
             support_max: s,
         })
     }
@@ -293,15 +312,16 @@ fn obstacle_wear(added: &[f64]) -> ObstacleWear {
             negative: added[1],
         },
         // the bins' depths are finite and ≥ 0 by construction
-        _ => ObstacleWear::Angular(
-            AngularProfile::new(added.to_vec()).unwrap_or_else(|| {
+        _ => {
+            ObstacleWear::Angular(AngularProfile::new(added.to_vec()).unwrap_or_else(|| {
                 AngularProfile::new(vec![0.0; added.len()]).expect("zero profile")
-            }),
-        ),
+            }))
+        }
     }
 }
 
 /// One window's wear work rate and its split over the bins, per wearing contact.
+#[derive(Clone)]
 struct Window {
     rates: Vec<f64>,
     fractions: Vec<Vec<f64>>,
@@ -341,8 +361,17 @@ fn window(
     let mut rates = Vec::with_capacity(wearing.len());
     let mut fractions = Vec::with_capacity(wearing.len());
     for &k in wearing {
-        rates.push(results.contacts[k].wear_work_rate);
-        let work = map.work(k);
+        let normal = model.wear[k].as_ref().map(|w| w.work) == Some(WearWork::Normal);
+        rates.push(
+            model.wear[k]
+                .as_ref()
+                .map_or(0.0, |w| w.work.rate(&results.contacts[k])),
+        );
+        let work = if normal {
+            map.normal_work(k)
+        } else {
+            map.work(k)
+        };
         let sum: f64 = work.iter().sum();
         fractions.push(if sum > 0.0 {
             work.iter().map(|w| w / sum).collect()
@@ -354,7 +383,14 @@ fn window(
 }
 
 /// The volumes after `[t0, t1]` at the window's rates.
-fn advanced(worn: &Worn, wear: &ContactWear, rate: f64, fractions: &[f64], t0: f64, t1: f64) -> Worn {
+fn advanced(
+    worn: &Worn,
+    wear: &ContactWear,
+    rate: f64,
+    fractions: &[f64],
+    t0: f64,
+    t1: f64,
+) -> Worn {
     let dvt = wear.tube.volume_increment(rate, t0, t1);
     let dvs = wear.support.volume_increment(rate, t0, t1);
     Worn {
@@ -377,6 +413,113 @@ fn deepest(d: &[f64]) -> f64 {
     d.iter().copied().fold(0.0, f64::max)
 }
 
+/// One wearing contact through the life: what it is, and its volumes with and without
+/// feedback.
+struct Track<'a> {
+    /// Index of the contact in the model.
+    k: usize,
+    name: String,
+    /// `contacts[k].wear`, for messages.
+    field: String,
+    wear: &'a ContactWear,
+    /// Clearance at rest `g₀`, m.
+    clearance: f64,
+    /// Volumes with the scars fed back.
+    worn: Worn,
+    /// Volumes of the fixed-gap extrapolation.
+    fixed: Worn,
+    /// When the tube's depth reached the criterion (with feedback, at fixed gap) and its wall.
+    criterion: Option<f64>,
+    criterion_fixed: Option<f64>,
+    perforation: Option<f64>,
+}
+
+/// A volume state advanced over a life step, with its depths.
+struct Advanced {
+    worn: Worn,
+    depths: Depths,
+}
+
+impl<'a> Track<'a> {
+    fn new(model: &'a Model, k: usize, bins: usize) -> Self {
+        let c = &model.contacts[k];
+        let x = model.basis.points[c.point].coords;
+        let worn = Worn::new(WearMap::new(model, bins).work(k).len());
+        Self {
+            k,
+            name: c.name.clone(),
+            field: format!("contacts[{k}].wear"),
+            wear: model.wear[k].as_ref().expect("a wearing contact"),
+            clearance: (-c.frame(&x, 0.0).penetration).max(0.0),
+            fixed: worn.clone(),
+            worn,
+            criterion: None,
+            criterion_fixed: None,
+            perforation: None,
+        }
+    }
+
+    fn advance(
+        &self,
+        from: &Worn,
+        rate: f64,
+        fractions: &[f64],
+        t0: f64,
+        t1: f64,
+    ) -> Result<Advanced> {
+        let worn = advanced(from, self.wear, rate, fractions, t0, t1);
+        let depths = worn.depths(self.wear, &self.field)?;
+        Ok(Advanced { worn, depths })
+    }
+
+    /// The longest step from `t` (at most `dt`) over which the added clearance grows by no
+    /// more than the settings allow (§14.5); beyond the scar's geometry counts as too much.
+    fn longest_step(
+        &self,
+        rate: f64,
+        fractions: &[f64],
+        t: f64,
+        dt: f64,
+        life: &LifeSettings,
+    ) -> Result<f64> {
+        let now = deepest(&self.worn.depths(self.wear, &self.field)?.added);
+        let limit = life.max_depth_change * (self.clearance + now).max(life.depth_resolution);
+        let grown = |h: f64| {
+            self.advance(&self.worn, rate, fractions, t, t + h)
+                .map_or(f64::INFINITY, |a| deepest(&a.depths.added) - now)
+        };
+        if grown(dt) <= limit {
+            return Ok(dt);
+        }
+        let (mut lo, mut hi) = (0.0, dt);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if grown(mid) > limit {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Ok(lo)
+    }
+
+    /// The time in `[t0, t1]` at which the tube's depth from `from` reaches `level`.
+    fn reaches(
+        &self,
+        from: &Worn,
+        rate: f64,
+        fractions: &[f64],
+        t0: f64,
+        t1: f64,
+        level: f64,
+    ) -> Result<f64> {
+        crossing(t0, t1, level, |h| {
+            self.advance(from, rate, fractions, t0, h)
+                .map(|a| deepest(&a.depths.tube))
+        })
+    }
+}
+
 /// The service life of `case` with its `[life]` settings (THEORY §14.5). `observer` sees
 /// each step as it is done.
 pub fn service_life(
@@ -387,38 +530,17 @@ pub fn service_life(
     life.validate("life")?;
     let start = Instant::now();
     let model = &case.model;
-    let wearing: Vec<usize> = (0..model.contacts.len())
+    let mut tracks: Vec<Track> = (0..model.contacts.len())
         .filter(|&k| model.wear.get(k).is_some_and(|w| w.is_some()))
+        .map(|k| Track::new(model, k, life.angular_bins))
         .collect();
-    if wearing.is_empty() {
+    if tracks.is_empty() {
         return Err(Error::invalid(
             "life",
             "no contact has a wear law: give `wear = { tube = …, support = …, scar = … }` in the [[contacts]] that wear (docs/WEAR.md)",
         ));
     }
-    let wear: Vec<&ContactWear> = wearing
-        .iter()
-        .map(|&k| model.wear[k].as_ref().expect("wearing"))
-        .collect();
-    let fields: Vec<String> = wearing.iter().map(|k| format!("contacts[{k}].wear")).collect();
-    let names: Vec<String> = wearing
-        .iter()
-        .map(|&k| model.contacts[k].name.clone())
-        .collect();
-    let clearances: Vec<f64> = wearing
-        .iter()
-        .map(|&k| {
-            let c = &model.contacts[k];
-            let x = model.basis.points[c.point].coords;
-            (-c.frame(&x, 0.0).penetration).max(0.0)
-        })
-        .collect();
-    let bins: Vec<usize> = wearing
-        .iter()
-        .map(|&k| WearMap::new(model, life.angular_bins).work(k).len())
-        .collect();
-    let mut worn: Vec<Worn> = bins.iter().map(|&b| Worn::new(b)).collect();
-    let mut fixed: Vec<Worn> = worn.clone();
+    let wearing: Vec<usize> = tracks.iter().map(|c| c.k).collect();
     let zero = ContactLife {
         wear_work_rate: 0.0,
         tube_volume: 0.0,
@@ -430,70 +552,40 @@ pub fn service_life(
     };
     let mut steps = vec![LifeStep {
         time: 0.0,
-        contacts: vec![zero; wearing.len()],
+        contacts: vec![zero; tracks.len()],
     }];
     observer(&steps[0]);
-    let mut time_to_criterion = vec![None; wearing.len()];
-    let mut time_fixed = vec![None; wearing.len()];
     let mut first: Option<Window> = None;
     let mut current = model.clone();
-    let mut t = 0.0;
-    let mut windows = 0;
+    let (mut t, mut windows) = (0.0, 0);
     let mut end = LifeEnd::StepLimit;
     for _ in 0..life.max_steps {
         if t >= life.target {
-            end = LifeEnd::Completed;
             break;
         }
-        // the window on the obstacles worn so far (the first one only without feedback)
-        let w = if life.feedback || first.is_none() {
-            windows += 1;
-            match window(case, &current, &wearing, life.angular_bins)? {
-                Ok(w) => w,
-                Err((step, contact)) => {
-                    end = LifeEnd::Diverged {
-                        window: windows - 1,
-                        time: t,
-                        step,
-                        contact,
-                    };
-                    break;
-                }
-            }
-        } else {
-            let f = first.as_ref().expect("first window");
-            Window {
-                rates: f.rates.clone(),
-                fractions: f.fractions.clone(),
-            }
-        };
-        let w0 = first.get_or_insert_with(|| Window {
-            rates: w.rates.clone(),
-            fractions: w.fractions.clone(),
-        });
-        // the longest step within the depth limit at every contact
-        let mut dt = life.target - t;
-        for (i, wear) in wear.iter().enumerate() {
-            let now = deepest(&worn[i].depths(wear, &fields[i])?.added);
-            let limit = life.max_depth_change * (clearances[i] + now).max(life.depth_resolution);
-            // beyond the geometry's limit counts as too much growth
-            let grown = |h: f64| -> f64 {
-                let next = advanced(&worn[i], wear, w.rates[i], &w.fractions[i], t, t + h);
-                next.depths(wear, &fields[i])
-                    .map_or(f64::INFINITY, |d| deepest(&d.added) - now)
-            };
-            if grown(dt) > limit {
-                let (mut lo, mut hi) = (0.0, dt);
-                for _ in 0..60 {
-                    let mid = 0.5 * (lo + hi);
-                    if grown(mid) > limit {
-                        hi = mid;
-                    } else {
-                        lo = mid;
+        // the window on the obstacles worn so far (only the first one without feedback)
+        let w = match &first {
+            Some(f) if !life.feedback => f.clone(),
+            _ => {
+                windows += 1;
+                match window(case, &current, &wearing, life.angular_bins)? {
+                    Ok(w) => w,
+                    Err((step, contact)) => {
+                        end = LifeEnd::Diverged {
+                            window: windows - 1,
+                            time: t,
+                            step,
+                            contact,
+                        };
+                        break;
                     }
                 }
-                dt = lo.max(f64::MIN_POSITIVE);
             }
+        };
+        let w0 = first.get_or_insert_with(|| w.clone()).clone();
+        let mut dt = life.target - t;
+        for (i, c) in tracks.iter().enumerate() {
+            dt = c.longest_step(w.rates[i], &w.fractions[i], t, dt, life)?;
         }
         let t1 = if life.target - t - dt <= 1e-12 * life.target {
             life.target
@@ -501,66 +593,63 @@ pub fn service_life(
             t + dt
         };
         // every contact's next state, or the first scar beyond its geometry
-        let mut next = Vec::with_capacity(wearing.len());
-        for (i, wear) in wear.iter().enumerate() {
-            let a = advanced(&worn[i], wear, w.rates[i], &w.fractions[i], t, t1);
-            let f = advanced(&fixed[i], wear, w0.rates[i], &w0.fractions[i], t, t1);
-            match (a.depths(wear, &fields[i]), f.depths(wear, &fields[i])) {
-                (Ok(d), Ok(df)) if t1 - t > 1e-12 * life.target => next.push((a, f, d, df)),
-                (Err(e), _) | (Ok(_), Err(e)) => {
-                    end = LifeEnd::ScarLimit {
-                        contact: names[i].clone(),
-                        time: t,
-                        message: e.to_string(),
+        let mut next = Vec::with_capacity(tracks.len());
+        for (i, c) in tracks.iter().enumerate() {
+            let a = c.advance(&c.worn, w.rates[i], &w.fractions[i], t, t1);
+            let f = c.advance(&c.fixed, w0.rates[i], &w0.fractions[i], t, t1);
+            match (a, f) {
+                (Ok(a), Ok(f)) if t1 - t > 1e-12 * life.target => next.push((a, f)),
+                (a, f) => {
+                    let message = match (a.err(), f.err()) {
+                        (Some(e), _) | (None, Some(e)) => e.to_string(),
+                        _ => "the scar's depth no longer grows within its geometry".into(),
                     };
-                    break;
-                }
-                _ => {
                     end = LifeEnd::ScarLimit {
-                        contact: names[i].clone(),
+                        contact: c.name.clone(),
                         time: t,
-                        message: "the scar's depth no longer grows within its geometry".into(),
+                        message,
                     };
                     break;
                 }
             }
         }
-        if next.len() < wearing.len() {
+        if next.len() < tracks.len() {
             break;
         }
-        let mut state = Vec::with_capacity(wearing.len());
-        for (i, (wear, (a, f, d, df))) in wear.iter().zip(next).enumerate() {
-            let before = std::mem::replace(&mut worn[i], a);
-            let fixed_before = std::mem::replace(&mut fixed[i], f);
-            if let Some(c) = life.criterion {
-                if time_to_criterion[i].is_none() && deepest(&d.tube) >= c {
-                    time_to_criterion[i] = Some(crossing(t, t1, c, |h| {
-                        let next = advanced(&before, wear, w.rates[i], &w.fractions[i], t, h);
-                        next.depths(wear, &fields[i]).map(|d| deepest(&d.tube))
-                    })?);
+        let mut state = Vec::with_capacity(tracks.len());
+        for (i, (c, (a, f))) in tracks.iter_mut().zip(next).enumerate() {
+            let (rate, fractions) = (w.rates[i], &w.fractions[i]);
+            let tube = deepest(&a.depths.tube);
+            let tube_fixed = deepest(&f.depths.tube);
+            if let Some(level) = life.criterion {
+                if c.criterion.is_none() && tube >= level {
+                    c.criterion = Some(c.reaches(&c.worn, rate, fractions, t, t1, level)?);
                 }
-                if time_fixed[i].is_none() && deepest(&df.tube) >= c {
-                    time_fixed[i] = Some(crossing(t, t1, c, |h| {
-                        let next = advanced(&fixed_before, wear, w0.rates[i], &w0.fractions[i], t, h);
-                        next.depths(wear, &fields[i]).map(|d| deepest(&d.tube))
-                    })?);
+                if c.criterion_fixed.is_none() && tube_fixed >= level {
+                    let (r0, f0) = (w0.rates[i], &w0.fractions[i]);
+                    c.criterion_fixed = Some(c.reaches(&c.fixed, r0, f0, t, t1, level)?);
                 }
+            }
+            if let Some(wall) = life.wall
+                && tube >= wall
+            {
+                c.perforation = Some(c.reaches(&c.worn, rate, fractions, t, t1, wall)?);
             }
             state.push(ContactLife {
-                wear_work_rate: w.rates[i],
-                tube_volume: worn[i].tube.iter().sum(),
-                support_volume: worn[i].support.iter().sum(),
-                tube_depth: deepest(&d.tube),
-                support_depth: d.support_max,
-                clearance_increase: deepest(&d.added),
-                tube_depth_fixed_gap: deepest(&df.tube),
+                wear_work_rate: rate,
+                tube_volume: a.worn.tube.iter().sum(),
+                support_volume: a.worn.support.iter().sum(),
+                tube_depth: tube,
+                support_depth: a.depths.support_max,
+                clearance_increase: deepest(&a.depths.added),
+                tube_depth_fixed_gap: tube_fixed,
             });
             if life.feedback {
-                let k = wearing[i];
-                current.contacts[k].obstacle = model.contacts[k]
+                current.contacts[c.k].obstacle = model.contacts[c.k]
                     .obstacle
-                    .worn(&obstacle_wear(&d.added), &fields[i])?;
+                    .worn(&obstacle_wear(&a.depths.added), &c.field)?;
             }
+            (c.worn, c.fixed) = (a.worn, f.worn);
         }
         t = t1;
         steps.push(LifeStep {
@@ -568,15 +657,27 @@ pub fn service_life(
             contacts: state,
         });
         observer(steps.last().expect("pushed"));
+        // the first tube through its wall ends the life
+        if let Some((name, time)) = tracks
+            .iter()
+            .filter_map(|c| c.perforation.map(|p| (&c.name, p)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+        {
+            end = LifeEnd::Perforated {
+                contact: name.clone(),
+                time,
+            };
+            break;
+        }
     }
     if t >= life.target && matches!(end, LifeEnd::StepLimit) {
         end = LifeEnd::Completed;
     }
-    let mut scars = Vec::with_capacity(wearing.len());
-    for (i, wear) in wear.iter().enumerate() {
-        let d = worn[i].depths(wear, &fields[i])?;
+    let mut scars = Vec::with_capacity(tracks.len());
+    for c in &tracks {
+        let d = c.worn.depths(c.wear, &c.field)?;
         scars.push(ScarProfile {
-            contact: names[i].clone(),
+            contact: c.name.clone(),
             kind: match d.added.len() {
                 1 => "plane",
                 2 => "bars",
@@ -587,11 +688,11 @@ pub fn service_life(
         });
     }
     Ok(LifeResults {
-        contacts: names,
-        clearances,
+        contacts: tracks.iter().map(|c| c.name.clone()).collect(),
+        clearances: tracks.iter().map(|c| c.clearance).collect(),
         steps,
-        time_to_criterion,
-        time_to_criterion_fixed_gap: time_fixed,
+        time_to_criterion: tracks.iter().map(|c| c.criterion).collect(),
+        time_to_criterion_fixed_gap: tracks.iter().map(|c| c.criterion_fixed).collect(),
         scars,
         end,
         windows,

@@ -75,6 +75,7 @@ impl LifeSection {
             max_depth_change: self.max_depth_change,
             depth_resolution: self.depth_resolution,
             criterion,
+            wall: tube.map(|t| t.structure.beam.tube.section.wall_thickness),
             feedback: self.feedback,
             angular_bins: self.angular_bins,
             max_steps: self.max_steps,

@@ -5,11 +5,14 @@ use serde::Deserialize;
 
 use super::contacts::ObstacleInput;
 use crate::error::{Error, Result, number};
-use crate::wear::{ContactWear, HoleScar, Scar, WearLaw};
+use crate::wear::{ContactWear, HoleScar, Scar, WearLaw, WearWork};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct WearInput {
+    /// The work the laws take: "friction" (default) or "normal".
+    #[serde(default)]
+    work: WorkInput,
     tube: LawInput,
     support: LawInput,
     scar: ScarInput,
@@ -31,6 +34,14 @@ enum LawInput {
         work_rate: Vec<f64>,
         volume_rate: Vec<f64>,
     },
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, Default)]
+#[serde(rename_all = "snake_case")]
+enum WorkInput {
+    #[default]
+    Friction,
+    Normal,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy)]
@@ -206,6 +217,10 @@ impl WearInput {
             tube: self.tube.law(),
             support: self.support.law(),
             scar,
+            work: match self.work {
+                WorkInput::Friction => WearWork::Friction,
+                WorkInput::Normal => WearWork::Normal,
+            },
         };
         wear.validate(&field)?;
         Ok(wear)

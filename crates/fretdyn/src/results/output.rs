@@ -83,13 +83,13 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
 
 /// The per-contact statistics; a contact with `wear` (docs/WEAR.md) also gets
 /// `tube_volume_rate` and `support_volume_rate`, m³/s, its laws at the run's wear work rate
-/// and service time 0 (THEORY §14).
+/// (friction or normal, as its `work` says) and service time 0 (THEORY §14).
 fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
     let mut contacts = json!(results.contacts);
     if let Some(list) = contacts.as_array_mut() {
         for (k, (entry, stats)) in list.iter_mut().zip(&results.contacts).enumerate() {
             if let (Some(w), Some(map)) = (case.model.contact_wear(k), entry.as_object_mut()) {
-                let (tube, support) = w.volume_rates(stats.wear_work_rate, 0.0);
+                let (tube, support) = w.volume_rates(w.work.rate(stats), 0.0);
                 map.insert("tube_volume_rate".into(), json!(tube));
                 map.insert("support_volume_rate".into(), json!(support));
             }

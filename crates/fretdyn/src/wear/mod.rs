@@ -4,11 +4,12 @@
 //! `docs/WEAR.md`). Nothing here runs in the time-step loop.
 //!
 //! ```
-//! use fretdyn::wear::{ContactWear, Scar, WearLaw};
+//! use fretdyn::wear::{ContactWear, Scar, WearLaw, WearWork};
 //! let wear = ContactWear {
 //!     tube: WearLaw::Archard { coefficient: 20e-15 },
 //!     support: WearLaw::Archard { coefficient: 10e-15 },
 //!     scar: Scar::FlatBar { tube_radius: 0.0095, width: 0.0254, tilt: 0.0 },
+//!     work: WearWork::Friction,
 //! };
 //! // 40 years at 10 mW
 //! let t = 40.0 * 365.25 * 86400.0;
@@ -37,6 +38,29 @@ pub struct ContactWear {
     pub support: WearLaw,
     /// The scar geometry.
     pub scar: Scar,
+    /// The work the laws take as `W`.
+    pub work: WearWork,
+}
+
+/// Which wear work rate a contact's laws take (THEORY §5, §14.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum WearWork {
+    /// The friction power `(1/T)∫|R_T·v_T| dt` (`wear_work_rate`).
+    #[default]
+    Friction,
+    /// The normal work rate `(1/T)∫R_N |v_T| dt` (`normal_wear_work_rate`): Code_Aster's
+    /// definition, on which most published coefficients are measured (docs/WEAR.md).
+    Normal,
+}
+
+impl WearWork {
+    /// The rate of a contact's statistics this work is.
+    pub fn rate(self, statistics: &crate::results::statistics::ContactStatistics) -> f64 {
+        match self {
+            WearWork::Friction => statistics.wear_work_rate,
+            WearWork::Normal => statistics.normal_wear_work_rate,
+        }
+    }
 }
 
 impl ContactWear {

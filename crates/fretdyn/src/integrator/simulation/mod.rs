@@ -686,7 +686,15 @@ impl<'m> Simulation<'m> {
         self.statistics
             .step(&self.settings.statistics, &self.names, t, dt, values);
         if let Some(map) = &mut self.wear_map {
-            track_wear(map, &self.contacts, model, &self.frame_rows, t, dt, self.settings);
+            track_wear(
+                map,
+                &self.contacts,
+                model,
+                &self.frame_rows,
+                t,
+                dt,
+                self.settings,
+            );
         }
         if sample {
             self.next_sample = self.next_sample.saturating_add(self.settings.output_every);
@@ -741,7 +749,12 @@ fn track_wear(
     if !settings.statistics.step_in_window(t, dt) {
         return;
     }
-    for (k, ((s, c), rows)) in states.iter().zip(&model.contacts).zip(frame_rows).enumerate() {
+    for (k, ((s, c), rows)) in states
+        .iter()
+        .zip(&model.contacts)
+        .zip(frame_rows)
+        .enumerate()
+    {
         if s.closed {
             map.add(k, &step_values(s, c, rows.as_ref(), t), dt);
         }

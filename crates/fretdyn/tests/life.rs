@@ -1,0 +1,219 @@
+//! Service life (THEORY §14.5): the depth against time of a contact whose wear rate does not
+//! depend on the gap against the closed forms of the wear law and the scar, the life-step
+//! limit, the time to the criterion, the scar fed back into the obstacle.
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use fretdyn::apps::life::{LifeEnd, LifeSettings, YEAR, service_life};
+use fretdyn::case::Case;
+
+/// A point mass pressed on a bar (10 N) that slides under it at 1 cm/s: once the transient has
+/// died out (heavily damped springs, window from 1 s) the mass stands still and the bar slides,
+/// `W = μ N v` exactly, whatever the gap: the bar's recession only moves the mass down.
+fn sliding_mass(wear: &str, life: &str) -> String {
+    format!(
+        r#"
+title = "mass sliding on a bar"
+[time]
+dt = 1e-4
+duration = 1.5
+[structure]
+type = "modal"
+frequencies_hz = [5.0, 5.0, 0.0]
+damping_ratio = 0.7
+[[structure.points]]
+name = "mass"
+coords = [0.0, 0.0, 0.0]
+rows = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+[[loads]]
+point = "mass"
+force = [0.0, 0.0, -10.0]
+[[contacts]]
+name = "bar"
+point = "mass"
+obstacle = {{ type = "plane", origin = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], gap = 0.0, tangent = [1.0, 0.0, 0.0] }}
+motion = {{ type = "velocity", velocity = [0.01, 0.0, 0.0] }}
+normal = {{ stiffness = 1e6, damping = 2000.0 }}
+friction = {{ mu = 0.3 }}
+wear = {wear}
+[tangential]
+method = "gauss_seidel"
+[statistics]
+t_start = 1.0
+[life]
+{life}
+"#
+    )
+}
+
+const W: f64 = 0.3 * 10.0 * 0.01;
+const R: f64 = 0.0095;
+const WIDTH: f64 = 0.02;
+
+/// Circular segment of height `u` in a circle of radius `r` (the flat cut of a tube).
+fn segment(r: f64, u: f64) -> f64 {
+    r * r * ((r - u) / r).acos() - (r - u) * (2.0 * r * u - u * u).sqrt()
+}
+
+/// The depth whose segment area is `a`, by bisection.
+fn depth_of_area(r: f64, a: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0, r);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if segment(r, mid) < a {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+fn case(wear: &str, life: &str) -> (Case, LifeSettings) {
+    let c = Case::from_toml_str(&sliding_mass(wear, life), Path::new(".")).unwrap();
+    let l = c.life.clone().unwrap();
+    (c, l)
+}
+
+const ARCHARD: &str = r#"{ tube = { law = "archard", coefficient = 2e-15 }, support = { law = "archard", coefficient = 1e-15 }, scar = { type = "flat_bar", width = 0.02, tube_radius = 0.0095 } }"#;
+
+#[test]
+fn constant_wear_rate_gives_the_closed_form_depth_against_time() {
+    let (case, life) = case(
+        ARCHARD,
+        "target_years = 40.0\nmax_depth_change = 0.2\ncriterion_depth = 4e-4",
+    );
+    let r = service_life(&case, &life, |_| {}).unwrap();
+    assert_eq!(r.end, LifeEnd::Completed);
+    assert!(r.steps.len() > 5, "{} steps", r.steps.len());
+    let mut worst = 0.0f64;
+    for s in &r.steps[1..] {
+        let c = &s.contacts[0];
+        // the transient of each window has died out to ~1e-8 by the window's start
+        assert!(
+            (c.wear_work_rate - W).abs() < 1e-7 * W,
+            "W = {}",
+            c.wear_work_rate
+        );
+        // V = K W t, V = w A_R(d) on the tube and on the bar (a groove of the tube's radius)
+        let tube = depth_of_area(R, 2e-15 * W * s.time / WIDTH);
+        let bar = depth_of_area(R, 1e-15 * W * s.time / WIDTH);
+        worst = worst.max((c.tube_depth - tube).abs() / tube);
+        worst = worst.max((c.support_depth - bar).abs() / bar);
+        // the approach: the overlap holding both volumes
+        let approach = depth_of_area(R, 3e-15 * W * s.time / WIDTH);
+        worst = worst.max((c.clearance_increase - approach).abs() / approach);
+        // no change of dynamics with the gap: the fixed-gap extrapolation is the same
+        assert!((c.tube_depth_fixed_gap - c.tube_depth).abs() <= 1e-6 * tube);
+    }
+    assert!(worst < 1e-6, "depth off by {worst:e}");
+    // the criterion: w A_R(d_c) = K W t_c
+    let tc = WIDTH * segment(R, 4e-4) / (2e-15 * W);
+    let found = r.time_to_criterion[0].unwrap();
+    assert!((found - tc).abs() < 1e-6 * tc, "{found} s, expected {tc} s");
+    assert!(tc < 40.0 * YEAR);
+}
+
+#[test]
+fn a_life_step_never_grows_the_depth_by_more_than_the_set_fraction() {
+    for f in [0.2, 0.05] {
+        let (case, life) = case(
+            ARCHARD,
+            &format!("target_years = 40.0\nmax_depth_change = {f}"),
+        );
+        let r = service_life(&case, &life, |_| {}).unwrap();
+        for pair in r.steps.windows(2) {
+            let (a, b) = (&pair[0].contacts[0], &pair[1].contacts[0]);
+            let limit = f * (r.clearances[0] + a.clearance_increase).max(life.depth_resolution);
+            let grown = b.clearance_increase - a.clearance_increase;
+            assert!(grown <= limit * (1.0 + 1e-9), "{grown:e} > {limit:e}");
+        }
+        // the steps are as long as allowed: all but the last use most of the limit
+        let n = r.steps.len();
+        assert!(n > 3);
+        let last = r.steps[n - 1].time;
+        assert!((last - 40.0 * YEAR).abs() < 1e-9 * last);
+    }
+}
+
+#[test]
+fn the_decaying_law_gives_its_closed_form_over_the_life() {
+    // V(t) = A W^B [s t + (1 − s)(1 − e^{−N t})/N]
+    let (a, b, s, n) = (2e-15, 1.2, 0.05, 1.0 / YEAR);
+    let wear = format!(
+        r#"{{ tube = {{ law = "decaying", a = {a:e}, b = {b}, s = {s}, n = {n:e} }}, support = {{ law = "archard", coefficient = 1e-15 }}, scar = {{ type = "flat_bar", width = 0.02, tube_radius = 0.0095 }} }}"#
+    );
+    let (case, life) = case(&wear, "target_years = 20.0\nmax_depth_change = 0.3");
+    let r = service_life(&case, &life, |_| {}).unwrap();
+    for st in &r.steps[1..] {
+        let t = st.time;
+        let v = a * W.powf(b) * (s * t + (1.0 - s) * (1.0 - (-n * t).exp()) / n);
+        let c = &st.contacts[0];
+        assert!(
+            (c.tube_volume - v).abs() < 1e-8 * v,
+            "{} vs {v}",
+            c.tube_volume
+        );
+        let d = depth_of_area(R, v / WIDTH);
+        assert!((c.tube_depth - d).abs() < 1e-6 * d);
+    }
+}
+
+#[test]
+fn bars_wear_on_the_side_that_is_rubbed_and_the_worn_side_recedes() {
+    // the same mass between two bars 0 and 1 mm away: pressed on the lower one only
+    let text = sliding_mass(ARCHARD, "target_years = 10.0\nmax_depth_change = 0.2").replace(
+        r#"{ type = "plane", origin = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], gap = 0.0, tangent = [1.0, 0.0, 0.0] }"#,
+        r#"{ type = "bi_plane", origin = [0.0, 0.0, 5e-4], normal = [0.0, 0.0, 1.0], gap = 5e-4, tangent = [1.0, 0.0, 0.0] }"#,
+    );
+    let case = Case::from_toml_str(&text, Path::new(".")).unwrap();
+    let life = case.life.clone().unwrap();
+    let r = service_life(&case, &life, |_| {}).unwrap();
+    let scar = &r.scars[0];
+    assert_eq!(scar.kind, "bars");
+    // the mass is below the mid-plane: the −n side (bin 1) wears, the +n side not at all
+    assert_eq!(scar.clearance_increase[0], 0.0);
+    let last = &r.steps[r.steps.len() - 1].contacts[0];
+    let tube = depth_of_area(R, 2e-15 * W * 10.0 * YEAR / WIDTH);
+    assert!((scar.tube_depth[1] - tube).abs() < 1e-6 * tube);
+    assert!((last.tube_depth - tube).abs() < 1e-6 * tube);
+    assert!((last.wear_work_rate - W).abs() < 1e-7 * W);
+}
+
+#[test]
+fn life_input_errors_name_the_field() {
+    let bad = |life: &str, wear: &str, needle: &str| {
+        let e = Case::from_toml_str(&sliding_mass(wear, life), Path::new("."))
+            .map(|_| ())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(needle), "{e}");
+    };
+    bad("target_years = -1.0", ARCHARD, "life.target_years");
+    bad(
+        "target_years = 1.0\nmax_depth_change = 2.0",
+        ARCHARD,
+        "life.max_depth_change",
+    );
+    bad(
+        "target_years = 1.0\ncriterion_wall_fraction = 0.4",
+        ARCHARD,
+        "life.criterion_wall_fraction",
+    );
+    bad(
+        "target_years = 1.0\nangular_bins = 2",
+        ARCHARD,
+        "life.angular_bins",
+    );
+    // a case whose contacts do not wear
+    let text =
+        sliding_mass(ARCHARD, "target_years = 1.0").replace(&format!("wear = {ARCHARD}\n"), "");
+    let case = Case::from_toml_str(&text, Path::new(".")).unwrap();
+    let e = service_life(&case, case.life.as_ref().unwrap(), |_| {}).unwrap_err();
+    assert!(
+        e.to_string().starts_with("life: no contact has a wear law"),
+        "{e}"
+    );
+    let _ = PI;
+}
