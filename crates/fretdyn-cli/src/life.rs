@@ -191,47 +191,72 @@ fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Fail
     )
 }
 
+/// Two panels, the tube depth of every contact against service time with the scars fed back
+/// and at fixed gap; the criterion drawn when the depths come near it (within 3×).
 fn draw(path: &Path, title: &str, r: &LifeResults, criterion: Option<f64>) -> Result<(), String> {
     let years: Vec<f64> = r.steps.iter().map(|s| s.time / YEAR).collect();
-    let columns: Vec<(Vec<f64>, Vec<f64>)> = (0..r.contacts.len())
-        .map(|k| {
-            (
-                r.steps.iter().map(|s| s.contacts[k].tube_depth).collect(),
-                r.steps
-                    .iter()
-                    .map(|s| s.contacts[k].tube_depth_fixed_gap)
-                    .collect(),
-            )
-        })
-        .collect();
-    let level: Vec<f64> = criterion.map_or_else(Vec::new, |c| vec![c; years.len()]);
-    let panels: Vec<(String, Vec<Series>)> = r
-        .contacts
+    let column = |k: usize, fixed: bool| -> Vec<f64> {
+        r.steps
+            .iter()
+            .map(|s| {
+                let c = &s.contacts[k];
+                if fixed { c.tube_depth_fixed_gap } else { c.tube_depth }
+            })
+            .collect()
+    };
+    let coupled: Vec<Vec<f64>> = (0..r.contacts.len()).map(|k| column(k, false)).collect();
+    let fixed: Vec<Vec<f64>> = (0..r.contacts.len()).map(|k| column(k, true)).collect();
+    let deepest = coupled
         .iter()
-        .zip(&columns)
-        .map(|(name, (coupled, fixed))| {
-            let mut s = vec![
-                Series {
-                    label: "scar fed back".into(),
-                    x: &years,
-                    y: coupled,
-                },
-                Series {
-                    label: "fixed gap".into(),
-                    x: &years,
-                    y: fixed,
-                },
-            ];
-            if !level.is_empty() {
-                s.push(Series {
-                    label: "criterion".into(),
-                    x: &years,
-                    y: &level,
-                });
-            }
-            (name.clone(), s)
-        })
-        .collect();
+        .chain(&fixed)
+        .flatten()
+        .copied()
+        .fold(0.0, f64::max);
+    let level: Vec<f64> = match criterion {
+        Some(c) if deepest >= c / 3.0 => vec![c; years.len()],
+        _ => Vec::new(),
+    };
+    fn panel<'a>(
+        label: &str,
+        names: &[String],
+        years: &'a [f64],
+        columns: &'a [Vec<f64>],
+        level: &'a [f64],
+    ) -> (String, Vec<Series<'a>>) {
+        let mut series: Vec<Series> = names
+            .iter()
+            .zip(columns)
+            .map(|(name, y)| Series {
+                label: name.clone(),
+                x: years,
+                y,
+            })
+            .collect();
+        if !level.is_empty() {
+            series.push(Series {
+                label: "criterion".into(),
+                x: years,
+                y: level,
+            });
+        }
+        (label.to_string(), series)
+    }
+    let panels = vec![
+        panel(
+            "scars fed back into the obstacles",
+            &r.contacts,
+            &years,
+            &coupled,
+            &level,
+        ),
+        panel(
+            "fixed gap (the first window's rates)",
+            &r.contacts,
+            &years,
+            &fixed,
+            &level,
+        ),
+    ];
     plot::panels_plot(
         path,
         &format!("{title}: tube wear depth"),

@@ -272,21 +272,20 @@ impl Worn {
                 ..
             }
         );
-        let shape: Vec<f64> = if uniform {
-            vec![1.0; n]
-        } else {
-            let total: Vec<f64> = self
-                .tube
-                .iter()
-                .zip(&self.support)
-                .map(|(a, b)| a + b)
-                .collect();
-            let max = total.iter().copied().fold(0.0, f64::max);
-            if max > 0.0 {
-                total.iter().map(|v| v / max).collect()
-            } else {
-                vec![0.0; n]
-            }
+        let total: Vec<f64> = self
+            .tube
+            .iter()
+            .zip(&self.support)
+            .map(|(a, b)| a + b)
+            .collect();
+        let shape: Vec<f64> = match wear.scar {
+            _ if uniform => vec![1.0; n],
+            Scar::DrilledHole {
+                tube_radius,
+                clearance,
+                ..
+            } => spread(&crescent_footprint(tube_radius, clearance, approach, n), &total),
+            _ => spread(&[1.0], &total),
         };
         Ok(Depths {
             tube: shape.iter().map(|f| f * t).collect(),
@@ -294,6 +293,51 @@ impl Worn {
             support_max: s,
         })
     }
+}
+
+/// The crescent a tube of radius `r` leaves when it is pushed `a` beyond a hole of clearance
+/// `c` (THEORY §14.4), over `n` bins: the thickness of the lens at the angle `φ` from its
+/// middle, `t(φ) = d cos φ + √(r² − d² sin²φ) − (r + c)` (≥ 0), `d = c + a`, relative to its
+/// depth `a`; index `j` is `φ = ±j 2π/n`, `j ∈ [0, n/2]` (it is even in `φ`).
+fn crescent_footprint(r: f64, c: f64, a: f64, n: usize) -> Vec<f64> {
+    if a <= 0.0 {
+        let mut one = vec![0.0; n / 2 + 1];
+        one[0] = 1.0;
+        return one;
+    }
+    let d = c + a;
+    (0..=n / 2)
+        .map(|j| {
+            let phi = std::f64::consts::TAU * j as f64 / n as f64;
+            let (s, co) = phi.sin_cos();
+            let inner = r * r - d * d * s * s;
+            if inner < 0.0 {
+                return 0.0;
+            }
+            ((d * co + inner.sqrt() - (r + c)) / a).max(0.0)
+        })
+        .collect()
+}
+
+/// The shape of a scar around a hole: each bin's volume spread by `footprint` (index `j`: `±j`
+/// bins away, periodic, `j ≤ n/2`), normalised to 1 where deepest (0 everywhere without
+/// volume).
+fn spread(footprint: &[f64], volumes: &[f64]) -> Vec<f64> {
+    let n = volumes.len();
+    let mut shape = vec![0.0; n];
+    for (b, v) in volumes.iter().enumerate().filter(|(_, v)| **v > 0.0) {
+        for (j, f) in footprint.iter().enumerate().filter(|(_, f)| **f > 0.0) {
+            shape[(b + j) % n] += v * f;
+            if j > 0 && 2 * j != n {
+                shape[(b + n - j) % n] += v * f;
+            }
+        }
+    }
+    let max = shape.iter().copied().fold(0.0, f64::max);
+    if max > 0.0 {
+        shape.iter_mut().for_each(|x| *x /= max);
+    }
+    shape
 }
 
 fn at(e: Error, field: &str) -> Error {
