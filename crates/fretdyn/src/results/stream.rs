@@ -156,7 +156,9 @@ pub fn resume(
             ),
         ));
     }
-    if checkpoint.snapshot.step >= settings.steps && dir.join(RESULTS_FILE).exists() {
+    let ended =
+        checkpoint.snapshot.step >= settings.steps || checkpoint.snapshot.target_met().is_some();
+    if ended && dir.join(RESULTS_FILE).exists() {
         // killed while removing series/, after the packing: what is left is not needed
         let _ = std::fs::remove_dir_all(dir.join(SERIES_DIR));
         return Err(Error::invalid(
@@ -266,7 +268,7 @@ fn drive(
     let total = settings.steps;
     let mut termination = Termination::Completed;
     let model = files.model_contacts.clone();
-    while sim.steps_done() < total {
+    while sim.steps_done() < total && sim.target_met().is_none() {
         if let Err(d) = sim.step() {
             termination = Termination::Diverged {
                 step: d.step,
@@ -499,7 +501,7 @@ impl Files {
                 b.block,
                 b.t_start,
                 b.t_end,
-                csv_name(&s.name),
+                csv_name(self.model_contacts.get(b.contact).map_or(&s.name, |n| n)),
                 s.impacts,
                 s.impacts_per_second,
                 s.contact_time_fraction,
