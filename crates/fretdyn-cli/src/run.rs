@@ -402,13 +402,19 @@ pub fn run_and_write(
 /// Warnings on the standard errors of a run (THEORY §5): once if the batches are correlated
 /// (too short against the correlation time), one line per contact whose relative standard
 /// errors exceed `[statistics] max_relative_error`, naming the statistics, and a target
-/// relative error that was not met.
+/// relative error that was not met. Only contacts with at least one impact per batch on
+/// average are looked at: with fewer (a single impact, a transient such as V1), the response
+/// is not a stationary one whose batch means could be independent, and its errors, still in
+/// `summary.json`, say nothing worth a warning.
 pub fn error_warnings(case: &Case, r: &RunResults) -> Vec<String> {
     let st = &case.settings.statistics;
     let mut out = Vec::new();
+    let stationary =
+        |c: &&fretdyn::results::statistics::ContactStatistics| c.impacts >= c.errors.batches.max(2);
     let correlated: Vec<String> = r
         .contacts
         .iter()
+        .filter(stationary)
         .filter(|c| c.errors.batches_correlated)
         .map(|c| {
             format!(
@@ -425,7 +431,7 @@ pub fn error_warnings(case: &Case, r: &RunResults) -> Vec<String> {
             number(c.errors.batch_length)
         ));
     }
-    for c in &r.contacts {
+    for c in r.contacts.iter().filter(stationary) {
         let above = c.relative_errors_above(st.max_relative_error);
         if !above.is_empty() {
             out.push(format!(
@@ -437,12 +443,6 @@ pub fn error_warnings(case: &Case, r: &RunResults) -> Vec<String> {
                     .map(|(s, e)| format!("{s} {:.1} %", 100.0 * e))
                     .collect::<Vec<_>>()
                     .join(", ")
-            ));
-        }
-        if c.errors.batches < 2 && c.duration > 0.0 {
-            out.push(format!(
-                "contact {}: fewer than 2 whole batches: no standard error",
-                c.name
             ));
         }
     }
