@@ -8,7 +8,7 @@
 //!   append, always gives the number of rows completely written, so that `numpy.load` reads
 //!   what a killed run had flushed;
 //! - `impacts.csv`: the per-impact table, appended as impacts end;
-//! - `blocks.csv`: the per-block statistics (when blocks are set);
+//! - `blocks.csv`: the per-block statistics (the batches of the standard errors: always);
 //! - `checkpoint.bin`: the [`Snapshot`] with the length of every file at that step, written to
 //!   a temporary name and renamed; its format is in [`CHECKPOINT_MAGIC`];
 //! - at the end, `results.npz`, packed from `series/` (copied entry by entry, never whole in
@@ -103,8 +103,9 @@ pub const RESULTS_FILE: &str = "results.npz";
 pub const CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNC";
 
 /// Format version of `checkpoint.bin` (1 was bincode, without a header; 2 counted the
-/// statistics' steps per contact and accumulated blocks when there were none).
-pub const CHECKPOINT_FORMAT: u32 = 4;
+/// statistics' steps per contact and accumulated blocks when there were none; 4 had blocks
+/// only when set, and no batch moments).
+pub const CHECKPOINT_FORMAT: u32 = 5;
 
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {
