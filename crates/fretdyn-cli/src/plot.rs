@@ -603,7 +603,11 @@ fn error_panels(
             let points = decimate(s.x, s.y, 4 * WIDTH as usize);
             let (colour, _) = style_of(k, series.len(), false);
             if points.len() <= MARKED_POINTS {
-                let marks = points.iter().map(|&p| Circle::new(p, 3, colour.filled()));
+                // the earlier series' marks larger, so that equal points all show
+                let radius = 3 + (series.len() - 1 - k).min(4) as i32;
+                let marks = points
+                    .iter()
+                    .map(|&p| Circle::new(p, radius, colour.filled()));
                 chart.draw_series(marks)?;
             }
             chart.draw_series(LineSeries::new(points, colour.stroke_width(1)))?;
