@@ -1,6 +1,7 @@
 //! Statistics accumulated at every step (not only at output samples), THEORY §5: per-contact
-//! wear, impact and force statistics over a time window `[t_start, t_end]` and optionally in
-//! blocks, and the table of impacts.
+//! wear, impact and force statistics over a time window `[t_start, t_end]` and in blocks
+//! (batches, from which the standard errors of the window's rates are estimated by batch
+//! means), and the table of impacts.
 //!
 //! A step `(t − Δt, t]` counts in the window (and in a block) when its midpoint `t − Δt/2` is
 //! in it, so that bounds that are multiples of Δt split the steps exactly despite round-off. An **impact** starts when the contact closes after being open longer than the rest
@@ -960,7 +961,8 @@ impl ContactAccumulator {
 ///
 /// Cost per step: an open contact with no impact in progress adds its offset and penetration
 /// to the block and keeps its penetration for the next crossing; the steps are counted once
-/// for all contacts, and one division finds whether the block closes.
+/// for all contacts, and one comparison of `t` tells whether the block may close (its index is
+/// computed only in the last two steps of a block).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ContactStatisticsState {
     /// Duration of a block, s (`∞`: one block, the window).
