@@ -39,10 +39,11 @@ pub struct Series<'a> {
     pub y: &'a [f64],
 }
 
-/// One bar: its label (on the x axis) and value.
+/// One bar: its label (on the x axis), value and standard error (drawn as a ± bar; 0: none).
 pub struct Bar {
     pub label: String,
     pub value: f64,
+    pub error: f64,
 }
 
 /// One bin of a histogram on a logarithmic axis: `[lo, hi)` (both > 0) and its count.
@@ -530,6 +531,96 @@ pub fn line_plot(
     )
 }
 
+/// A vertical error bar at `x` from `lo` to `hi`, with caps of half-width `cap` (in x units).
+fn error_bar(x: f64, lo: f64, hi: f64, cap: f64, colour: RGBColor) -> [PathElement<(f64, f64)>; 3] {
+    let style = colour.stroke_width(1);
+    [
+        PathElement::new(vec![(x, lo), (x, hi)], style),
+        PathElement::new(vec![(x - cap, lo), (x + cap, lo)], style),
+        PathElement::new(vec![(x - cap, hi), (x + cap, hi)], style),
+    ]
+}
+
+/// [`panels_plot`] with ± error bars: `errors[p][s]` the standard errors of the points of
+/// series `s` of panel `p` (empty: none).
+pub fn panels_plot_with_errors(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    panels_in: &[(String, Vec<Series>)],
+    errors: &[Vec<Vec<f64>>],
+) -> Result<(), String> {
+    let borrowed: Vec<(String, &[Series])> = panels_in
+        .iter()
+        .map(|(t, s)| (t.clone(), s.as_slice()))
+        .collect();
+    let height = 60 + 300 * borrowed.len().max(1) as u32;
+    finish(
+        path,
+        error_panels(path, title, x_label, y_label, &borrowed, errors, height),
+    )
+}
+
+fn error_panels(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    panels: &[(String, &[Series])],
+    errors: &[Vec<Vec<f64>>],
+    height: u32,
+) -> DrawResult<()> {
+    let (root, areas) = canvas(path, (WIDTH, height), title, (panels.len().max(1), 1))?;
+    for (p, ((panel_title, series), area)) in panels.iter().zip(areas).enumerate() {
+        let (x_range, mut y_range) = ranges(series);
+        let cap = 0.01 * (x_range.end - x_range.start);
+        let bars: Vec<(usize, f64, f64, f64)> = series
+            .iter()
+            .enumerate()
+            .flat_map(|(k, s)| {
+                let e = errors.get(p).and_then(|e| e.get(k));
+                s.x.iter()
+                    .zip(s.y)
+                    .enumerate()
+                    .filter_map(move |(i, (&x, &y))| {
+                        let e = e.and_then(|e| e.get(i)).copied().unwrap_or(0.0);
+                        (e.is_finite() && e > 0.0 && y.is_finite()).then_some((k, x, y - e, y + e))
+                    })
+            })
+            .collect();
+        for &(_, _, lo, hi) in &bars {
+            y_range = y_range.start.min(lo)..y_range.end.max(hi);
+        }
+        let mut chart = frame(
+            &area,
+            panel_title,
+            &keys(series, false),
+            AxisSpec::new(x_label, x_range, Scale::Linear),
+            AxisSpec::new(y_label, y_range, Scale::Linear),
+        )?;
+        for (k, s) in series.iter().enumerate() {
+            let points = decimate(s.x, s.y, 4 * WIDTH as usize);
+            let (colour, _) = style_of(k, series.len(), false);
+            if points.len() <= MARKED_POINTS {
+                // the earlier series' marks larger, so that equal points all show
+                let radius = 3 + (series.len() - 1 - k).min(4) as i32;
+                let marks = points
+                    .iter()
+                    .map(|&p| Circle::new(p, radius, colour.filled()));
+                chart.draw_series(marks)?;
+            }
+            chart.draw_series(LineSeries::new(points, colour.stroke_width(1)))?;
+        }
+        for &(k, x, lo, hi) in &bars {
+            let (colour, _) = style_of(k, series.len(), false);
+            chart.draw_series(error_bar(x, lo, hi, cap, colour))?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}
+
 /// Stacked panels, one per entry (panel title, series), sharing the x label; 300 px each.
 pub fn panels_plot(
     path: &Path,
@@ -680,8 +771,15 @@ fn draw_bars(
     for ((panel_title, bars), area) in panels.iter().zip(areas) {
         let names: Vec<String> = bars.iter().map(|b| b.label.clone()).collect();
         let value = |b: &Bar| if b.value.is_finite() { b.value } else { 0.0 };
-        let top = bars.iter().map(value).fold(0.0, f64::max);
-        let bottom = bars.iter().map(value).fold(0.0, f64::min);
+        let error = |b: &Bar| {
+            if b.error.is_finite() {
+                b.error.abs()
+            } else {
+                0.0
+            }
+        };
+        let top = bars.iter().map(|b| value(b) + error(b)).fold(0.0, f64::max);
+        let bottom = bars.iter().map(|b| value(b) - error(b)).fold(0.0, f64::min);
         let (bottom, top) = if top > bottom {
             (1.1 * bottom, 1.1 * top)
         } else {
@@ -698,6 +796,11 @@ fn draw_bars(
             let x = i as f64;
             Rectangle::new([(x + 0.1, 0.0), (x + 0.9, value(b))], COLOURS[0].filled())
         }))?;
+        // ± one standard error
+        for (i, b) in bars.iter().enumerate().filter(|(_, b)| error(b) > 0.0) {
+            let (x, lo, hi) = (i as f64 + 0.5, value(b) - error(b), value(b) + error(b));
+            chart.draw_series(error_bar(x, lo, hi, 0.1, BLACK))?;
+        }
     }
     root.present()?;
     Ok(())
@@ -1051,6 +1154,7 @@ mod tests {
             .map(|i| Bar {
                 label: format!("plate{i}"),
                 value: 1.0,
+                error: 0.0,
             })
             .collect();
         let backend = BitMapBackend::with_buffer(&mut pixels, (w, h));

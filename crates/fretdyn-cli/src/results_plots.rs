@@ -313,6 +313,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
                 .map(|k| Bar {
                     label: names[k].clone(),
                     value: rate(k, "wear_work_rate"),
+                    error: rate(k, "wear_work_rate_se"),
                 })
                 .collect(),
         ),
@@ -322,6 +323,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
                 .map(|k| Bar {
                     label: names[k].clone(),
                     value: rate(k, "normal_wear_work_rate"),
+                    error: rate(k, "normal_wear_work_rate_se"),
                 })
                 .collect(),
         ),
@@ -329,7 +331,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
     let path = dir.join("wear.png");
     bar_panels(
         &path,
-        &format!("{title} — wear work rate per contact"),
+        &format!("{title} — wear work rate per contact (± standard error)"),
         "wear work rate (W)",
         &panels,
     )

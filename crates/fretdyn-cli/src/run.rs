@@ -365,6 +365,9 @@ pub fn run_and_write(
         }
     })?;
     observer.bar.finish();
+    for w in error_warnings(case, &results) {
+        errln!("warning: {w}");
+    }
     if options.plots {
         crate::results_plots::plot_run(dir)?;
     }
@@ -394,6 +397,70 @@ pub fn run_and_write(
             dir.display()
         ))),
     }
+}
+
+/// Warnings on the standard errors of a run (THEORY §5): once if the batches are correlated
+/// (too short against the correlation time), one line per contact whose relative standard
+/// errors exceed `[statistics] max_relative_error`, naming the statistics, and a target
+/// relative error that was not met. Only contacts with at least one impact per batch on
+/// average are looked at: with fewer (a single impact, a transient such as V1), the response
+/// is not a stationary one whose batch means could be independent, and its errors, still in
+/// `summary.json`, say nothing worth a warning.
+pub fn error_warnings(case: &Case, r: &RunResults) -> Vec<String> {
+    let st = &case.settings.statistics;
+    let mut out = Vec::new();
+    let stationary =
+        |c: &&fretdyn::results::statistics::ContactStatistics| c.impacts >= c.errors.batches.max(2);
+    let correlated: Vec<String> = r
+        .contacts
+        .iter()
+        .filter(stationary)
+        .filter(|c| c.errors.batches_correlated)
+        .map(|c| {
+            format!(
+                "{} (r1 = {:.2})",
+                c.name,
+                c.errors.batch_autocorrelation.unwrap_or(f64::NAN)
+            )
+        })
+        .collect();
+    if let Some(c) = r.contacts.first().filter(|_| !correlated.is_empty()) {
+        out.push(format!(
+            "the batch means are correlated at {}: batches of {} s are too short against the correlation time of the response, and the standard errors are underestimated; set a longer [statistics] block (or fewer batches), or run longer",
+            correlated.join(", "),
+            number(c.errors.batch_length)
+        ));
+    }
+    for c in r.contacts.iter().filter(stationary) {
+        let above = c.relative_errors_above(st.max_relative_error);
+        if !above.is_empty() {
+            out.push(format!(
+                "contact {}: relative standard error above {} % (statistics.max_relative_error): {}; run longer (or set statistics.target_relative_error)",
+                c.name,
+                number(100.0 * st.max_relative_error),
+                above
+                    .iter()
+                    .map(|(s, e)| format!("{s} {:.1} %", 100.0 * e))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+    }
+    if let (Some(target), None) = (st.target_relative_error, r.target_met_at) {
+        if matches!(r.termination, Termination::Completed) {
+            out.push(format!(
+                "the target relative error {} % (statistics.target_relative_error) was not met within time.duration = {} s; the run went to its end",
+                number(100.0 * target),
+                number(r.steps as f64 * r.dt)
+            ));
+        }
+    }
+    out
+}
+
+/// `x` as typed (shortest round-trip form).
+fn number(x: f64) -> String {
+    format!("{x}")
 }
 
 /// Reads `t` and `contact_tangential_force` of a finished run.
@@ -427,18 +494,31 @@ fn report(case: &Case, r: &RunResults, dir: &Path) -> Result<(), Failure> {
         "stick",
         "slip",
         "max R_N (N)",
-        "wear rate (W)"
+        "wear rate (W) ± SE"
     )?;
     for c in &r.contacts {
         outln!(
-            "  {:<16} {:>8} {:>8.4} {:>8.4} {:>8.4} {:>12.5e} {:>14.5e}",
+            "  {:<16} {:>8} {:>8.4} {:>8.4} {:>8.4} {:>12.5e} {:>14.5e} ± {}",
             c.name,
             c.impacts,
             c.contact_time_fraction,
             c.stick_time_fraction,
             c.slip_time_fraction,
             c.normal_force_max,
-            c.wear_work_rate
+            c.wear_work_rate,
+            c.errors
+                .wear_work_rate_se
+                .map_or("-".to_string(), |e| format!("{e:.2e}"))
+        )?;
+    }
+    if let Some(c) = r.contacts.first() {
+        outln!(
+            "  standard errors by batch means: {} batches of {} s{}",
+            c.errors.batches,
+            number(c.errors.batch_length),
+            r.target_met_at
+                .map(|t| format!("; target relative error met at t = {} s", number(t)))
+                .unwrap_or_default()
         )?;
     }
     outln!(

@@ -10,7 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Failure;
 use crate::out::{errln, outln};
-use crate::plot::{Series, panels_plot};
+use crate::plot::{Series, panels_plot_with_errors};
 
 /// Entry point of `fretdyn sweep`.
 pub fn main(
@@ -120,8 +120,14 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
         })
         .collect();
     let mut data: Vec<(String, Vec<Line>)> = Vec::new();
+    // the standard errors of the points, line by line, panel by panel (± bars)
+    let mut errors: Vec<Vec<Vec<f64>>> = Vec::new();
     for (contact, col) in &contacts {
+        let se_col = header
+            .iter()
+            .position(|h| *h == format!("{contact}.{statistic}_se"));
         let mut lines: Vec<Line> = Vec::new();
+        let mut line_errors: Vec<Vec<f64>> = Vec::new();
         let mut sorted = rows.clone();
         sorted.sort_by(|a, b| {
             let (p, q) = (a[xi].parse::<f64>(), b[xi].parse::<f64>());
@@ -139,15 +145,21 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
             let (Ok(xv), Ok(yv)) = (r[xi].parse::<f64>(), r[*col].parse::<f64>()) else {
                 continue;
             };
-            match lines.iter_mut().find(|l| l.0 == label) {
-                Some(l) => {
-                    l.1.push(xv);
-                    l.2.push(yv);
+            let ev = se_col.and_then(|i| r[i].parse::<f64>().ok()).unwrap_or(0.0);
+            match lines.iter().position(|l| l.0 == label) {
+                Some(i) => {
+                    lines[i].1.push(xv);
+                    lines[i].2.push(yv);
+                    line_errors[i].push(ev);
                 }
-                None => lines.push((label, vec![xv], vec![yv])),
+                None => {
+                    lines.push((label, vec![xv], vec![yv]));
+                    line_errors.push(vec![ev]);
+                }
             }
         }
         data.push((contact.clone(), lines));
+        errors.push(line_errors);
     }
     let y_label = statistic_label(statistic);
     let panels: Vec<(String, Vec<Series>)> = data
@@ -172,12 +184,16 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
         .collect();
     let (x_name, _) = parameter_name(x);
     let (y_name, _) = statistic_name(statistic);
-    panels_plot(
+    panels_plot_with_errors(
         path,
-        &format!("{} against {x_name}", capitalised(&y_name)),
+        &format!(
+            "{} against {x_name} (± standard error)",
+            capitalised(&y_name)
+        ),
         &parameter_label(x),
         &y_label,
         &panels,
+        &errors,
     )
     .map_err(Failure::failed)
 }

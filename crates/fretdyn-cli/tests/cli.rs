@@ -1153,3 +1153,88 @@ fn study_syntax_errors_give_their_line_and_column() {
         "{stderr}"
     );
 }
+
+/// A short run of the multi-span tube: summary.json carries the standard errors of every
+/// rate, the batches and their check; the too-large relative errors of so short a run are
+/// warned about on stderr, one line per contact naming the statistics (a contact with fewer
+/// impacts than batches, a transient, is not); a target relative
+/// error is reported as met or not; a block longer than the window is refused naming the
+/// field.
+#[test]
+fn a_run_reports_its_standard_errors_and_warns_when_they_are_large() {
+    let s = Scratch::new("errors");
+    let text = std::fs::read_to_string(examples().join("tube_multispan.toml"))
+        .unwrap()
+        .replace("duration = 2.0", "duration = 0.2");
+    std::fs::write(s.0.join("short.toml"), &text).unwrap();
+    let out = fretdyn(
+        &["run", "short.toml", "-o", "out", "--quiet", "--no-plots"],
+        &s.0,
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(s.0.join("out/summary.json")).unwrap())
+            .unwrap();
+    let errors = &summary["standard_errors"];
+    assert_eq!(errors["batches"], 20);
+    assert!((errors["batch_length"].as_f64().unwrap() - 0.01).abs() < 1e-12);
+    assert!(errors.get("target_met").is_none(), "no target, no key");
+    let mut some_warned = false;
+    for c in summary["contacts"].as_array().unwrap() {
+        assert_eq!(c["batches"], 20);
+        for key in fretdyn::results::statistics::BATCHED_STATISTICS {
+            let se = c[format!("{key}_se")].as_f64();
+            assert!(se.is_some_and(|e| e >= 0.0), "{key}_se of {}", c["name"]);
+        }
+        assert!(c["batches_correlated"].is_boolean());
+        let name = c["name"].as_str().unwrap();
+        let rse = c["wear_work_rate_se"].as_f64().unwrap() / c["wear_work_rate"].as_f64().unwrap();
+        let warned = stderr.lines().any(|l| {
+            l.starts_with(&format!("warning: contact {name}:")) && l.contains("wear_work_rate")
+        });
+        // only a contact with at least an impact per batch is a stationary response
+        let stationary = c["impacts"].as_u64().unwrap() >= 20;
+        assert_eq!(
+            warned,
+            stationary && rse > 0.05,
+            "{name}: relative error {rse}: {stderr}"
+        );
+        some_warned |= warned;
+    }
+    assert!(some_warned, "0.2 s is too short: {stderr}");
+    // a target too small to be met within the duration
+    std::fs::write(
+        s.0.join("target.toml"),
+        format!("{text}\n[statistics]\ntarget_relative_error = 0.001\n"),
+    )
+    .unwrap();
+    let out = fretdyn(
+        &["run", "target.toml", "-o", "t", "--quiet", "--no-plots"],
+        &s.0,
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("was not met"), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(s.0.join("t/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["standard_errors"]["target_met"], false);
+    assert_eq!(summary["standard_errors"]["target_relative_error"], 0.001);
+    // a block longer than the window
+    std::fs::write(
+        s.0.join("bad.toml"),
+        format!("{text}\n[statistics]\nblock = 0.5\n"),
+    )
+    .unwrap();
+    let out = fretdyn(&["run", "bad.toml", "-o", "b", "--quiet"], &s.0);
+    assert_one_line_error(
+        &out,
+        2,
+        &[
+            "bad.toml",
+            "statistics.block",
+            "longer than the statistics window",
+        ],
+    );
+}

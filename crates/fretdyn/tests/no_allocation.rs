@@ -1,10 +1,10 @@
 //! The time-step loop allocates nothing, random turbulence included: a run of 10× more steps
 //! makes exactly as many heap allocations (all of them in the set-up and in the results), counted by a global allocator
-//! on the test's own thread only (the test harness allocates on its main thread meanwhile).
+//! on each test's own thread only (the test harness allocates on its main thread meanwhile,
+//! and the tests run in parallel).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use fretdyn::apps::benchmark::rattling_tube;
 use fretdyn::contact::tangential::{
@@ -14,17 +14,21 @@ use fretdyn::integrator::simulation::simulate;
 
 struct Counting;
 
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
 thread_local! {
-    /// Set on the thread whose allocations are counted.
+    /// Set on the threads whose allocations are counted.
     static COUNTED: Cell<bool> = const { Cell::new(false) };
+    /// The allocations of this thread (each test counts its own: they run in parallel).
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
 }
 
 fn count() {
     if COUNTED.with(|c| c.get()) {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        ALLOCATIONS.with(|a| a.set(a.get() + 1));
     }
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|a| a.get())
 }
 
 unsafe impl GlobalAlloc for Counting {
@@ -97,12 +101,9 @@ fn allocations_of_run(
             g.block_length()
         );
     }
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = allocations();
     let r = simulate(&case.model, &case.settings).expect("valid case");
-    (
-        ALLOCATIONS.load(Ordering::Relaxed) - before,
-        r.solver.lagrange_steps,
-    )
+    (allocations() - before, r.solver.lagrange_steps)
 }
 
 #[test]
@@ -132,5 +133,32 @@ fn the_step_loop_does_not_allocate() {
                 method.name()
             );
         }
+    }
+}
+
+/// Closing a block (a batch of the standard errors, THEORY §5) allocates nothing in the
+/// step loop: 200 blocks of 100 steps, and a target relative error checked at each of
+/// them (too small to be met), counted over the steps only.
+#[test]
+fn closing_blocks_does_not_allocate() {
+    use fretdyn::integrator::simulation::Simulation;
+    COUNTED.with(|c| c.set(true));
+    let method = TangentialMethod::ActiveSet(ActiveSetSettings::default());
+    for target in [None, Some(1e-9)] {
+        let mut case = rattling_tube(10, 4, method, 20_000);
+        case.settings.output_every = 100;
+        case.settings.statistics.block = Some(100.0 * case.settings.dt);
+        case.settings.statistics.target_relative_error = target;
+        let mut sim = Simulation::new(&case.model, &case.settings).expect("valid case");
+        let before = allocations();
+        while sim.steps_done() < case.settings.steps {
+            sim.step().expect("no divergence");
+        }
+        let during = allocations() - before;
+        assert_eq!(sim.target_met(), None);
+        let r = sim.finish(0.0, fretdyn::integrator::simulation::Termination::Completed);
+        assert_eq!(r.blocks.len(), 200 * 4, "200 blocks of 4 contacts");
+        assert_eq!(r.contacts[0].errors.batches, 200);
+        assert_eq!(during, 0, "target {target:?}: allocations in the step loop");
     }
 }

@@ -75,6 +75,23 @@ fn a_grid_study_runs_in_parallel_and_resumes_without_redoing_runs() {
     assert_eq!(cols[2], "active_set");
     let wear: f64 = cols[6 + 8].parse().unwrap(); // plane.wear_work_rate
     assert_eq!(wear, r.contacts[0].wear_work_rate);
+    // and its standard error by batch means, in `<contact>.wear_work_rate_se`
+    let header: Vec<String> = std::fs::read_to_string(&serial)
+        .unwrap()
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .map(String::from)
+        .collect();
+    let se = header
+        .iter()
+        .position(|h| h == "plane.wear_work_rate_se")
+        .expect("the column of the standard error");
+    assert_eq!(header.len(), cols.len());
+    let expected = r.contacts[0].errors.wear_work_rate_se.unwrap();
+    assert_eq!(cols[se].parse::<f64>().unwrap(), expected);
+    assert!(expected > 0.0);
 
     // a crash: two rows kept, one cut in two; resumed: only the two missing runs are done
     let text = std::fs::read_to_string(&serial).unwrap();

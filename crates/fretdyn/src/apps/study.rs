@@ -118,6 +118,15 @@ pub const TABLE_STATISTICS: [&str; 10] = [
     "normal_wear_work_rate",
 ];
 
+/// The statistics of [`TABLE_STATISTICS`] with a standard error by batch means, written
+/// as `<contact>.<statistic>_se` after a contact's statistics (empty with fewer than 2
+/// batches).
+pub fn table_errors() -> impl Iterator<Item = &'static str> {
+    TABLE_STATISTICS
+        .into_iter()
+        .filter(|s| crate::results::statistics::BATCHED_STATISTICS.contains(s))
+}
+
 impl Study {
     /// Reads a study file.
     pub fn from_file(path: &Path) -> Result<Self> {
@@ -313,6 +322,9 @@ impl Study {
             for s in TABLE_STATISTICS {
                 cols.push(format!("{c}.{s}"));
             }
+            for s in table_errors() {
+                cols.push(format!("{c}.{s}_se"));
+            }
         }
         cols.push(CONNORS_COLUMN.to_string());
         cols.join(",")
@@ -451,6 +463,10 @@ impl Study {
             let v = serde_json::to_value(c).unwrap_or_default();
             for s in TABLE_STATISTICS {
                 cols.push(v[s].as_f64().map(|x| x.to_string()).unwrap_or_default());
+            }
+            for s in table_errors() {
+                let se = &v[format!("{s}_se")];
+                cols.push(se.as_f64().map(|x| x.to_string()).unwrap_or_default());
             }
         }
         cols.push(

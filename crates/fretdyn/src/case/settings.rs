@@ -14,18 +14,42 @@ use crate::integrator::stability::checked_stable_time_step;
 use crate::model::Model;
 use crate::results::statistics::StatisticsSettings;
 
-/// `[statistics]`: the window, blocks, impact definition and wear coefficient (THEORY §5).
-#[derive(Debug, Default, Deserialize)]
+/// `[statistics]`: the window, blocks (batches), standard errors and their target, impact
+/// definition and wear coefficient (THEORY §5).
+#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct StatisticsSection {
     #[serde(default)]
     t_start: f64,
     t_end: Option<f64>,
     block: Option<f64>,
+    batches: Option<u64>,
+    target_relative_error: Option<f64>,
+    #[serde(default = "default_max_relative_error")]
+    max_relative_error: f64,
     #[serde(default)]
     rest_duration: f64,
     #[serde(default)]
     wear_coefficient: f64,
+}
+
+impl Default for StatisticsSection {
+    fn default() -> Self {
+        Self {
+            t_start: 0.0,
+            t_end: None,
+            block: None,
+            batches: None,
+            target_relative_error: None,
+            max_relative_error: default_max_relative_error(),
+            rest_duration: 0.0,
+            wear_coefficient: 0.0,
+        }
+    }
+}
+
+fn default_max_relative_error() -> f64 {
+    crate::results::statistics::DEFAULT_MAX_RELATIVE_ERROR
 }
 
 #[derive(Debug, Deserialize)]
@@ -249,6 +273,12 @@ impl CaseFile {
                 ),
             ));
         }
+        if statistics.block.is_some() && statistics.batches.is_some() {
+            return Err(Error::invalid(
+                "statistics.batches",
+                "is given with statistics.block: give one of them (block: the batch duration in s; batches: their number in the window)",
+            ));
+        }
         let steps = (duration / dt).round();
         if steps > 1e12 {
             return Err(Error::invalid(
@@ -269,11 +299,27 @@ impl CaseFile {
                 t_start: self.statistics.t_start,
                 t_end: self.statistics.t_end.unwrap_or(f64::INFINITY),
                 block: self.statistics.block,
+                batches: self.statistics.batches,
+                target_relative_error: self.statistics.target_relative_error,
+                max_relative_error: self.statistics.max_relative_error,
                 rest_duration: self.statistics.rest_duration,
                 wear_coefficient: self.statistics.wear_coefficient,
             },
         };
         settings.validate()?;
+        let window =
+            self.statistics.t_end.unwrap_or(f64::INFINITY).min(duration) - self.statistics.t_start;
+        if let Some(block) = self.statistics.block.filter(|b| *b > window * (1.0 + 1e-9)) {
+            return Err(Error::invalid(
+                "statistics.block",
+                format!(
+                    "{} s is longer than the statistics window ({} s): the standard errors need several batches in it; set block ≤ a tenth of the window or leave it out ({} batches by default)",
+                    number(block),
+                    number(window),
+                    crate::results::statistics::DEFAULT_BATCHES
+                ),
+            ));
+        }
         // a model without a usable stable time step (a unit slip: a mass of 1e-320 kg, a
         // radius of 1e200 m) is refused here, naming its cause; a Δt above a usable limit is
         // left to the run, which says the limit

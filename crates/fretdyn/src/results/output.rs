@@ -44,10 +44,27 @@ pub fn write_results_npz(dir: &Path, results: &RunResults) -> Result<PathBuf> {
     Ok(path)
 }
 
-/// The JSON summary of a run: the case echoed, per-contact statistics, energy balance, solver
-/// statistics, steps, wall time and steps/s.
+/// The JSON summary of a run: the case echoed, per-contact statistics with their standard
+/// errors (`<statistic>_se`, `batches`, `batch_length`, `batch_autocorrelation`,
+/// `batches_correlated`), the standard errors' settings and whether a target was met,
+/// energy balance, solver statistics, steps, wall time and steps/s.
 pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
     let s = &results.solver;
+    let st = &case.settings.statistics;
+    let mut standard_errors = json!({
+        "method": "batch means",
+        "batch_length": results.contacts.first().map_or(0.0, |c| c.errors.batch_length),
+        "batches": results.contacts.first().map_or(0, |c| c.errors.batches),
+        "batches_correlated": results.contacts.iter().any(|c| c.errors.batches_correlated),
+        "max_relative_error": st.max_relative_error,
+    });
+    if let Some(target) = st.target_relative_error {
+        standard_errors["target_relative_error"] = json!(target);
+        standard_errors["target_met"] = json!(results.target_met_at.is_some());
+        if let Some(t) = results.target_met_at {
+            standard_errors["target_met_at"] = json!(t);
+        }
+    }
     json!({
         "fretdyn_version": env!("CARGO_PKG_VERSION"),
         "title": case.title,
@@ -61,6 +78,7 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
             "samples": results.steps / case.settings.output_every + 1,
         },
         "contacts": contacts_with_wear(case, results),
+        "standard_errors": standard_errors,
         "contact_geometry": case.model.contacts.iter().map(|c| json!({
             "name": c.name,
             "obstacle": c.obstacle.kind(),

@@ -1,6 +1,7 @@
 //! Statistics accumulated at every step (not only at output samples), THEORY §5: per-contact
-//! wear, impact and force statistics over a time window `[t_start, t_end]` and optionally in
-//! blocks, and the table of impacts.
+//! wear, impact and force statistics over a time window `[t_start, t_end]` and in blocks
+//! (batches, from which the standard errors of the window's rates are estimated by batch
+//! means), and the table of impacts.
 //!
 //! A step `(t − Δt, t]` counts in the window (and in a block) when its midpoint `t − Δt/2` is
 //! in it, so that bounds that are multiples of Δt split the steps exactly despite round-off. An **impact** starts when the contact closes after being open longer than the rest
@@ -27,8 +28,18 @@ pub struct StatisticsSettings {
     pub t_start: f64,
     /// End of the window, s (`f64::INFINITY`: the end of the run).
     pub t_end: f64,
-    /// Duration of the blocks the window is also cut into, s (`None`: no blocks).
+    /// Duration of the blocks (batches) the window is cut into, s (`None`: [`Self::batches`]
+    /// of the window, see [`StatisticsSettings::block_length`]).
     pub block: Option<f64>,
+    /// Number of batches of the window when `block` is not given (`None`: [`DEFAULT_BATCHES`],
+    /// or [`DEFAULT_TARGET_BATCHES`] of the longest window with a target).
+    pub batches: Option<u64>,
+    /// Stop the run once the relative standard error of the wear work rate of every contact
+    /// that wears is at most this (checked at the end of each batch, from
+    /// [`MIN_TARGET_BATCHES`] batches on); the run's duration is then the longest.
+    pub target_relative_error: Option<f64>,
+    /// A relative standard error above this is worth a warning (front ends).
+    pub max_relative_error: f64,
     /// An opening longer than this ends an impact; shorter ones are rebounds, s.
     pub rest_duration: f64,
     /// Wear coefficient `K_wear` of the work-rate (Archard-type) wear law, m³/J:
@@ -36,12 +47,19 @@ pub struct StatisticsSettings {
     pub wear_coefficient: f64,
 }
 
+/// Relative standard error above which a statistic is worth a warning, by default: 5 %, the
+/// spread at which two runs of a study differ visibly on a plot.
+pub const DEFAULT_MAX_RELATIVE_ERROR: f64 = 0.05;
+
 impl Default for StatisticsSettings {
     fn default() -> Self {
         Self {
             t_start: 0.0,
             t_end: f64::INFINITY,
             block: None,
+            batches: None,
+            target_relative_error: None,
+            max_relative_error: DEFAULT_MAX_RELATIVE_ERROR,
             rest_duration: 0.0,
             wear_coefficient: 0.0,
         }
@@ -73,6 +91,33 @@ impl StatisticsSettings {
                     format!("must be a positive duration in s (got {b})"),
                 ));
             }
+        }
+        if let Some(n) = self.batches {
+            if n < 2 {
+                return Err(Error::invalid(
+                    format!("{field}.batches"),
+                    format!("must be at least 2 batches to estimate an error (got {n})"),
+                ));
+            }
+        }
+        if let Some(e) = self.target_relative_error {
+            if !(e.is_finite() && e > 0.0 && e < 1.0) {
+                return Err(Error::invalid(
+                    format!("{field}.target_relative_error"),
+                    format!(
+                        "must be a relative standard error in (0, 1), e.g. 0.02 for 2 % (got {e})"
+                    ),
+                ));
+            }
+        }
+        if !(self.max_relative_error.is_finite() && self.max_relative_error > 0.0) {
+            return Err(Error::invalid(
+                format!("{field}.max_relative_error"),
+                format!(
+                    "must be a positive relative standard error, e.g. 0.05 for 5 % (got {})",
+                    self.max_relative_error
+                ),
+            ));
         }
         if !(self.rest_duration.is_finite() && self.rest_duration >= 0.0) {
             return Err(Error::invalid(
@@ -448,7 +493,8 @@ impl ContactAccumulator {
         self.peak_histogram[bin] += 1;
     }
 
-    /// Statistics over the `steps` steps added, each of duration `dt`.
+    /// Statistics over the `steps` steps added, each of duration `dt`, named `name`, with
+    /// the histogram of peak forces (no errors: those come from the batches).
     pub fn finish(
         &self,
         steps: u64,
@@ -456,22 +502,8 @@ impl ContactAccumulator {
         dt: f64,
         wear_coefficient: f64,
     ) -> ContactStatistics {
-        let n = steps.max(1) as f64;
-        let nc = self.contact_steps.max(1) as f64;
-        let duration = steps as f64 * dt;
-        let extremum = |x: f64| if steps > 0 { x } else { 0.0 };
-        let rate = |x: f64| if duration > 0.0 { x / duration } else { 0.0 };
-        let ni = self.finished_impacts.max(1) as f64;
-        let (angle_mean, angle_spread) = if self.contact_steps > 0 {
-            let (c, s) = (self.angle_cos / nc, self.angle_sin / nc);
-            let r = c.hypot(s).min(1.0);
-            (
-                s.atan2(c).to_degrees(),
-                (-2.0 * r.max(1e-300).ln()).sqrt().to_degrees(),
-            )
-        } else {
-            (0.0, 0.0)
-        };
+        let mut s = self.statistics(steps, dt, wear_coefficient);
+        s.name = name.to_string();
         // sized first: the number of allocations does not depend on the data
         let mut histogram = Vec::with_capacity(
             self.peak_histogram
@@ -494,8 +526,30 @@ impl ContactAccumulator {
                     }
                 }),
         );
+        s.peak_force_histogram = histogram;
+        s
+    }
+
+    /// [`Self::finish`] without the name and the histogram: allocates nothing (a block's).
+    fn statistics(&self, steps: u64, dt: f64, wear_coefficient: f64) -> ContactStatistics {
+        let n = steps.max(1) as f64;
+        let nc = self.contact_steps.max(1) as f64;
+        let duration = steps as f64 * dt;
+        let extremum = |x: f64| if steps > 0 { x } else { 0.0 };
+        let rate = |x: f64| if duration > 0.0 { x / duration } else { 0.0 };
+        let ni = self.finished_impacts.max(1) as f64;
+        let (angle_mean, angle_spread) = if self.contact_steps > 0 {
+            let (c, s) = (self.angle_cos / nc, self.angle_sin / nc);
+            let r = c.hypot(s).min(1.0);
+            (
+                s.atan2(c).to_degrees(),
+                (-2.0 * r.max(1e-300).ln()).sqrt().to_degrees(),
+            )
+        } else {
+            (0.0, 0.0)
+        };
         ContactStatistics {
-            name: name.to_string(),
+            name: String::new(),
             duration,
             impacts: self.impacts,
             impacts_per_second: rate(self.impacts as f64),
@@ -525,7 +579,8 @@ impl ContactAccumulator {
             displacement_max: extremum(self.radial_max),
             contact_angle_mean_deg: angle_mean,
             contact_angle_spread_deg: angle_spread,
-            peak_force_histogram: histogram,
+            peak_force_histogram: Vec::new(),
+            errors: StandardErrors::default(),
         }
     }
 }
@@ -601,6 +656,9 @@ pub struct ContactStatistics {
     pub contact_angle_spread_deg: f64,
     /// Histogram of the impacts' peak normal forces (non-empty bins).
     pub peak_force_histogram: Vec<PeakBin>,
+    /// Standard errors by batch means (a window's; a block's are empty).
+    #[serde(flatten)]
+    pub errors: StandardErrors,
 }
 
 /// Statistics of one contact over one block.
@@ -608,6 +666,8 @@ pub struct ContactStatistics {
 pub struct BlockStatistics {
     /// Block number (0 is the first block of the window).
     pub block: u64,
+    /// Index of the contact.
+    pub contact: usize,
     /// Start and end of the block, s.
     pub t_start: f64,
     pub t_end: f64,
@@ -615,56 +675,434 @@ pub struct BlockStatistics {
     pub statistics: ContactStatistics,
 }
 
-/// Everything the statistics keep for the contacts of a run: window and block accumulators,
-/// impact trackers; finished impacts and blocks wait in [`Self::impacts`] and
+/// Statistics whose standard error is estimated by batch means (THEORY §5), in the order of
+/// [`StandardErrors`]' fields. The two rms values are estimated through the mean squares.
+pub const BATCHED_STATISTICS: [&str; BATCHED] = [
+    "wear_work_rate",
+    "normal_wear_work_rate",
+    "impacts_per_second",
+    "contact_time_fraction",
+    "stick_time_fraction",
+    "slip_time_fraction",
+    "normal_force_mean",
+    "normal_force_rms",
+    "tangential_force_mean",
+    "tangential_force_rms",
+];
+const BATCHED: usize = 10;
+/// Index in [`BATCHED_STATISTICS`] of the mean squares (their rms is reported).
+const MEAN_SQUARES: [usize; 2] = [7, 9];
+
+/// Batches of the window when `[statistics] block` is not given (and no target is set).
+pub const DEFAULT_BATCHES: u64 = 20;
+/// Batches of the longest window (`time.duration`) when a target relative error is set: the
+/// batch length is then fixed before the run, short enough for the run to stop early.
+pub const DEFAULT_TARGET_BATCHES: u64 = 100;
+/// Batches needed before a target relative error is checked (fewer give too noisy an SE).
+pub const MIN_TARGET_BATCHES: u64 = 20;
+/// A contact holds a run with a target while its wear work rate is at least this fraction
+/// of the largest contact's (one that barely wears is reported, with its error, but does not
+/// make the run go on).
+pub const TARGET_WEAR_SHARE: f64 = 0.01;
+
+/// Standard errors of a window's statistics by batch means (THEORY §5): the window is cut
+/// into `batches` batches of `batch_length`, the statistic `x_b` of each batch is formed, and
+/// `SE(x̄) = √(Σ(x_b − x̄)² / (n_b (n_b − 1)))`, valid when the batches are longer than the
+/// correlation time of the response (then the `x_b` are independent). For an rms,
+/// `SE(rms) = SE(mean square) / (2 rms)`. `None` (left out of `summary.json`) with fewer
+/// than 2 batches. A last, partial batch (a run stopped early) is left out.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct StandardErrors {
+    /// Whole batches the errors are formed from.
+    pub batches: u64,
+    /// Duration of a batch, s.
+    pub batch_length: f64,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub wear_work_rate_se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub normal_wear_work_rate_se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub impacts_per_second_se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub contact_time_fraction_se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub stick_time_fraction_se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub slip_time_fraction_se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub normal_force_mean_se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub normal_force_rms_se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub tangential_force_mean_se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub tangential_force_rms_se: Option<f64>,
+    /// Lag-1 autocorrelation `r₁` of the batch means of the wear work rate (of the impact
+    /// rate, the contact time fraction or the mean normal force when it does not vary).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub batch_autocorrelation: Option<f64>,
+    /// `r₁ > 2/√n_b`: the batches are too short against the correlation time (independent
+    /// batch means give `r₁ ≈ 0 ± 1/√n_b`) and the errors are underestimated by about
+    /// `√((1 + r₁)/(1 − r₁))`; use longer batches (`[statistics] block`) or a longer run.
+    pub batches_correlated: bool,
+}
+
+impl StandardErrors {
+    /// The standard errors in the order of [`BATCHED_STATISTICS`].
+    pub fn values(&self) -> [Option<f64>; BATCHED] {
+        [
+            self.wear_work_rate_se,
+            self.normal_wear_work_rate_se,
+            self.impacts_per_second_se,
+            self.contact_time_fraction_se,
+            self.stick_time_fraction_se,
+            self.slip_time_fraction_se,
+            self.normal_force_mean_se,
+            self.normal_force_rms_se,
+            self.tangential_force_mean_se,
+            self.tangential_force_rms_se,
+        ]
+    }
+}
+
+impl ContactStatistics {
+    /// `(name, value, standard error)` of the statistics of [`BATCHED_STATISTICS`].
+    pub fn batched(&self) -> [(&'static str, f64, Option<f64>); BATCHED] {
+        let values = [
+            self.wear_work_rate,
+            self.normal_wear_work_rate,
+            self.impacts_per_second,
+            self.contact_time_fraction,
+            self.stick_time_fraction,
+            self.slip_time_fraction,
+            self.normal_force_mean,
+            self.normal_force_rms,
+            self.tangential_force_mean,
+            self.tangential_force_rms,
+        ];
+        let se = self.errors.values();
+        std::array::from_fn(|i| (BATCHED_STATISTICS[i], values[i], se[i]))
+    }
+
+    /// The statistics of [`BATCHED_STATISTICS`] whose relative standard error `SE/|x|`
+    /// exceeds `threshold`, with it (a statistic that is 0 has none). The split of the
+    /// contact time into stick and slip is left out: its smaller part is often a few steps
+    /// per batch, noisy, and of no consequence for the wear (its error is reported).
+    pub fn relative_errors_above(&self, threshold: f64) -> Vec<(&'static str, f64)> {
+        self.batched()
+            .into_iter()
+            .filter(|(name, _, _)| !matches!(*name, "stick_time_fraction" | "slip_time_fraction"))
+            .filter_map(|(name, x, se)| {
+                let r = se? / x.abs();
+                (x != 0.0 && r > threshold).then_some((name, r))
+            })
+            .collect()
+    }
+}
+
+/// Running sums over the batch means of one contact, shifted by the first batch's so that
+/// `Σ(x_b − x̄)²` does not cancel: `d_b = x_b − x_1`, `Σd_b`, `Σd_b²`, `Σd_b d_{b−1}`, and the
+/// last `d_b`. Fixed size: a run of any length keeps the same room.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+struct BatchMoments {
+    n: u64,
+    shift: [f64; BATCHED],
+    sum: [f64; BATCHED],
+    squares: [f64; BATCHED],
+    lag: [f64; BATCHED],
+    last: [f64; BATCHED],
+}
+
+impl BatchMoments {
+    fn add(&mut self, x: &[f64; BATCHED]) {
+        if self.n == 0 {
+            self.shift = *x;
+        }
+        for i in 0..BATCHED {
+            let d = x[i] - self.shift[i];
+            self.sum[i] += d;
+            self.squares[i] += d * d;
+            self.lag[i] += d * self.last[i];
+            self.last[i] = d;
+        }
+        self.n += 1;
+    }
+
+    /// Mean of the batch means, `Σ(x_b − x̄)²` and `Σ(x_b − x̄)(x_{b−1} − x̄)`.
+    fn moments(&self, i: usize) -> (f64, f64, f64) {
+        let n = self.n as f64;
+        let m = self.sum[i] / n;
+        let ss = (self.squares[i] - n * m * m).max(0.0);
+        // d_1 = 0 by the shift
+        let lag = self.lag[i] - m * (2.0 * self.sum[i] - self.last[i]) + (n - 1.0) * m * m;
+        (self.shift[i] + m, ss, lag)
+    }
+
+    /// Standard error of the mean of statistic `i`, `√(Σ(x_b − x̄)²/(n(n−1)))`.
+    fn se(&self, i: usize) -> Option<f64> {
+        (self.n >= 2).then(|| {
+            let n = self.n as f64;
+            (self.moments(i).1 / (n * (n - 1.0))).sqrt()
+        })
+    }
+
+    /// The errors of the window's statistics `s`.
+    fn errors(&self, s: &ContactStatistics, batch_length: f64) -> StandardErrors {
+        let mut se: [Option<f64>; BATCHED] = std::array::from_fn(|i| self.se(i));
+        for (i, rms) in MEAN_SQUARES
+            .into_iter()
+            .zip([s.normal_force_rms, s.tangential_force_rms])
+        {
+            se[i] = se[i].map(|e| if rms > 0.0 { e / (2.0 * rms) } else { 0.0 });
+        }
+        // a statistic varies when its spread is above the round-off of its mean
+        let n = self.n as f64;
+        let headline = [0, 2, 3, 6]
+            .into_iter()
+            .map(|i| self.moments(i))
+            .find(|(m, ss, _)| *ss > n * (1e-12 * m).powi(2) && *ss > f64::MIN_POSITIVE);
+        let r1 = (self.n >= 3)
+            .then_some(headline)
+            .flatten()
+            .map(|(_, ss, lag)| (lag / ss).clamp(-1.0, 1.0))
+            .filter(|r| r.is_finite());
+        StandardErrors {
+            batches: self.n,
+            // a window without a step has no batch
+            batch_length: if batch_length.is_finite() {
+                batch_length
+            } else {
+                0.0
+            },
+            wear_work_rate_se: se[0],
+            normal_wear_work_rate_se: se[1],
+            impacts_per_second_se: se[2],
+            contact_time_fraction_se: se[3],
+            stick_time_fraction_se: se[4],
+            slip_time_fraction_se: se[5],
+            normal_force_mean_se: se[6],
+            normal_force_rms_se: se[7],
+            tangential_force_mean_se: se[8],
+            tangential_force_rms_se: se[9],
+            batch_autocorrelation: r1,
+            batches_correlated: r1.is_some_and(|r| r > 2.0 / (self.n as f64).sqrt()),
+        }
+    }
+}
+
+impl ContactAccumulator {
+    /// The batch means of [`BATCHED_STATISTICS`] over `steps` steps of `dt` (mean squares
+    /// for the rms).
+    fn batch_values(&self, steps: u64, dt: f64) -> [f64; BATCHED] {
+        let n = steps.max(1) as f64;
+        let duration = n * dt;
+        [
+            self.wear_work / duration,
+            self.normal_wear_work / duration,
+            self.impacts as f64 / duration,
+            self.contact_steps as f64 / n,
+            self.stick_steps as f64 / n,
+            self.slip_steps as f64 / n,
+            self.normal_sum / n,
+            self.normal_sq_sum / n,
+            self.tangential_sum / n,
+            self.tangential_sq_sum / n,
+        ]
+    }
+
+    /// Adds the sums of `other` (a block closed) to these (the window's): counts and
+    /// extrema exactly, the `f64` sums as one more addition (a sum over the window is then a
+    /// sum of block sums: equal to the step-by-step sum to round-off, THEORY §5).
+    fn merge(&mut self, other: &Self) {
+        self.contact_steps += other.contact_steps;
+        self.stick_steps += other.stick_steps;
+        self.slip_steps += other.slip_steps;
+        self.impacts += other.impacts;
+        self.finished_impacts += other.finished_impacts;
+        self.rebounds += other.rebounds;
+        self.duration_sum += other.duration_sum;
+        self.duration_min = match (self.duration_min, other.duration_min) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        self.duration_max = self.duration_max.max(other.duration_max);
+        self.normal_sum += other.normal_sum;
+        self.normal_sq_sum += other.normal_sq_sum;
+        self.normal_max = self.normal_max.max(other.normal_max);
+        self.tangential_sum += other.tangential_sum;
+        self.tangential_sq_sum += other.tangential_sq_sum;
+        self.tangential_max = self.tangential_max.max(other.tangential_max);
+        self.wear_work += other.wear_work;
+        self.normal_wear_work += other.normal_wear_work;
+        self.penetration_max = larger(self.penetration_max, other.penetration_max);
+        self.radial_sum += other.radial_sum;
+        self.radial_sq_sum += other.radial_sq_sum;
+        self.radial_min = smaller(self.radial_min, other.radial_min);
+        self.radial_max = larger(self.radial_max, other.radial_max);
+        self.angle_cos += other.angle_cos;
+        self.angle_sin += other.angle_sin;
+        for (a, b) in self.peak_histogram.iter_mut().zip(&other.peak_histogram) {
+            *a += b;
+        }
+    }
+}
+
+/// Everything the statistics keep for the contacts of a run: block and window accumulators,
+/// batch means, impact trackers; finished impacts and blocks wait in [`Self::impacts`] and
 /// [`Self::blocks`] until drained by the caller (a streaming run drains them at each flush,
 /// so that memory stays flat).
 ///
+/// The window is always cut into blocks (batches, THEORY §5): of `[statistics] block` s, or
+/// else [`DEFAULT_BATCHES`] of the window ([`DEFAULT_TARGET_BATCHES`] of the longest window
+/// with a target relative error). A step is added to the block's sums only; when the block
+/// closes (at the step whose successor's midpoint is in the next block), its sums are added
+/// to the window's, its batch means to the batch moments and its row to [`Self::blocks`]
+/// (room reserved beforehand: closing a block does not allocate).
+///
 /// Cost per step: an open contact with no impact in progress adds its offset and penetration
-/// to the window (and to the block, when there are blocks: without, there are no block
-/// accumulators at all) and keeps its penetration for the next crossing; the steps are
-/// counted once for all contacts.
+/// to the block and keeps its penetration for the next crossing; the steps are counted once
+/// for all contacts, and one comparison of `t` tells whether the block may close (its index is
+/// computed only in the last two steps of a block).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ContactStatisticsState {
-    settings_block: Option<f64>,
+    /// Duration of a block, s (`∞`: one block, the window).
+    block_length: f64,
+    /// Relative standard error at which the run stops.
+    target: Option<f64>,
     window: Vec<ContactAccumulator>,
-    /// Steps in the window so far (the same for every contact).
+    /// Steps in the closed blocks (the same for every contact).
     window_steps: u64,
-    /// One per contact with blocks, none without.
+    /// The block in progress, one per contact.
     block: Vec<ContactAccumulator>,
     /// Steps in the current block so far.
     block_steps: u64,
     block_index: u64,
+    /// No step ending before this closes the current block (so that the block of the next
+    /// step is only computed near the block's end).
+    close_from: f64,
+    batches: Vec<BatchMoments>,
+    /// End of the step at which the target relative error was met.
+    target_met: Option<f64>,
     trackers: Vec<ImpactTracker>,
     /// Finished impacts started in the window, not yet drained.
     pub impacts: Vec<Impact>,
-    /// Finished blocks `(block, contact, accumulator)`, not yet drained.
+    /// Finished blocks, block by block, contact by contact, not yet drained; their names are
+    /// empty (the contact is [`BlockStatistics::contact`]) until [`name_blocks`].
     pub blocks: Vec<BlockStatistics>,
 }
 
+/// Gives the rows of `blocks` the names of their contacts (a row is formed in the step loop
+/// without its name, which would allocate).
+pub fn name_blocks(blocks: &mut [BlockStatistics], names: &[String]) {
+    for b in blocks {
+        if let Some(name) = names.get(b.contact) {
+            b.statistics.name.clone_from(name);
+        }
+    }
+}
+
+/// Most block rows reserved before the run (beyond, a streamed run's drain makes room).
+const BLOCK_ROOM: u64 = 4096;
+
+impl StatisticsSettings {
+    /// Steps of a run of `steps` steps of `dt` that count in the window (midpoint rule).
+    pub fn window_steps(&self, steps: u64, dt: f64) -> u64 {
+        // first and last step in the window, found near their estimates by the rule itself
+        let inside = |n: u64| n >= 1 && n <= steps && self.step_in_window(n as f64 * dt, dt);
+        let estimate = |t: f64| ((t / dt + 0.5).floor().max(0.0) as u64).min(steps);
+        let mut first = estimate(self.t_start);
+        while first > 1 && inside(first - 1) {
+            first -= 1;
+        }
+        while first <= steps && !inside(first) {
+            first += 1;
+        }
+        if first > steps {
+            return 0;
+        }
+        let mut last = estimate(self.t_end.min(steps as f64 * dt)).max(first);
+        while last < steps && inside(last + 1) {
+            last += 1;
+        }
+        while last > first && !inside(last) {
+            last -= 1;
+        }
+        last + 1 - first
+    }
+
+    /// Duration of the blocks of a run of `steps` steps of `dt`: `block` if set, else the
+    /// window cut into [`StatisticsSettings::batches`] (default [`DEFAULT_BATCHES`], or
+    /// [`DEFAULT_TARGET_BATCHES`] with a target), of whole or nearly whole steps (at most one
+    /// step apart), and no shorter than a step.
+    pub fn block_length(&self, steps: u64, dt: f64) -> f64 {
+        if let Some(b) = self.block {
+            return b;
+        }
+        let n = self.window_steps(steps, dt);
+        let batches = self
+            .batches
+            .unwrap_or(if self.target_relative_error.is_some() {
+                DEFAULT_TARGET_BATCHES
+            } else {
+                DEFAULT_BATCHES
+            });
+        let batches = batches.min(n).max(1);
+        if n == 0 {
+            f64::INFINITY
+        } else {
+            n as f64 * dt / batches as f64
+        }
+    }
+}
+
 impl ContactStatisticsState {
-    /// Empty statistics for `contacts` contacts.
-    pub fn new(contacts: usize, settings: &StatisticsSettings) -> Self {
-        let blocks = settings.block.is_some();
-        Self {
-            settings_block: settings.block,
+    /// Empty statistics for `contacts` contacts, for a run of `steps` steps of `dt`.
+    pub fn new(contacts: usize, settings: &StatisticsSettings, steps: u64, dt: f64) -> Self {
+        let block_length = settings.block_length(steps, dt);
+        let blocks = (settings.window_steps(steps, dt) as f64 * dt / block_length).ceil();
+        let rows = (blocks.min(BLOCK_ROOM as f64) as usize + 2) * contacts;
+        let mut state = Self {
+            block_length,
+            target: settings.target_relative_error,
             window: vec![ContactAccumulator::new(); contacts],
             window_steps: 0,
-            block: vec![ContactAccumulator::new(); if blocks { contacts } else { 0 }],
+            block: vec![ContactAccumulator::new(); contacts],
             block_steps: 0,
             block_index: 0,
+            batches: vec![BatchMoments::default(); contacts],
+            target_met: None,
             trackers: vec![ImpactTracker::default(); contacts],
             // room for the impacts that end between two drains: the step loop does not
             // allocate unless more wait (then the room grows once and is kept)
             impacts: Vec::with_capacity(IMPACT_ROOM_PER_CONTACT * contacts),
-            blocks: Vec::with_capacity(if blocks { 4 * contacts } else { 0 }),
-        }
+            blocks: Vec::with_capacity(rows),
+            close_from: 0.0,
+        };
+        state.close_from = state.close_from_for(settings, dt);
+        state
+    }
+
+    /// Two steps before the end of the current block (round-off cannot close it sooner).
+    fn close_from_for(&self, settings: &StatisticsSettings, dt: f64) -> f64 {
+        settings.t_start + (self.block_index + 1) as f64 * self.block_length - 2.0 * dt
     }
 
     /// True when it follows `n` contacts.
     pub fn has_contacts(&self, n: usize) -> bool {
-        let blocks = if self.settings_block.is_some() { n } else { 0 };
-        self.window.len() == n && self.block.len() == blocks && self.trackers.len() == n
+        self.window.len() == n
+            && self.block.len() == n
+            && self.batches.len() == n
+            && self.trackers.len() == n
+    }
+
+    /// Duration of a block (batch), s.
+    pub fn block_length(&self) -> f64 {
+        self.block_length
+    }
+
+    /// End time of the step at which the target relative error was met, if it was.
+    pub fn target_met(&self) -> Option<f64> {
+        self.target_met
     }
 
     /// Starts the trackers at t = 0 with the contacts' penetrations.
@@ -682,78 +1120,106 @@ impl ContactStatisticsState {
     pub fn step(
         &mut self,
         settings: &StatisticsSettings,
-        names: &[String],
+        _names: &[String],
         t: f64,
         dt: f64,
         values: impl Iterator<Item = StepValues>,
     ) {
         let in_window = settings.step_in_window(t, dt);
-        if in_window {
-            self.window_steps += 1;
-            if let Some(b) = settings.block {
-                // the block of this step; close the previous ones
-                let index = settings.block_of(t, dt, b);
-                while index > self.block_index {
-                    self.close_block(settings, names, dt);
-                }
-                self.block_steps += 1;
-            }
-        }
+        self.block_steps += in_window as u64;
         let rest = settings.rest_duration;
         let Self {
-            window,
             block,
             trackers,
             impacts,
             ..
         } = self;
-        for (k, ((v, tracker), window)) in values.zip(trackers.iter_mut()).zip(window).enumerate() {
+        for (k, ((v, tracker), block)) in values.zip(trackers.iter_mut()).zip(block).enumerate() {
             // the sums and the impacts' counts are apart: their order does not matter
             if in_window {
-                window.add_step(&v, dt);
-                if let Some(block) = block.get_mut(k) {
-                    block.add_step(&v, dt);
-                }
+                block.add_step(&v, dt);
             }
             if tracker.busy(&v) {
-                impact_step(
-                    k,
-                    v,
-                    rest,
-                    in_window,
-                    tracker,
-                    window,
-                    block.get_mut(k),
-                    impacts,
-                );
+                impact_step(k, v, rest, in_window, tracker, block, impacts);
             } else {
                 tracker.idle(&v);
             }
         }
+        if in_window && t >= self.close_from {
+            // the block closes when the next step's midpoint is in a later one
+            let next = settings.block_of(t + dt, dt, self.block_length);
+            if next > self.block_index {
+                self.close_block(settings, dt, true, t);
+                self.block_index = next;
+                self.close_from = self.close_from_for(settings, dt);
+            }
+        }
     }
 
-    fn close_block(&mut self, settings: &StatisticsSettings, names: &[String], dt: f64) {
-        let b = settings.block.unwrap_or(f64::INFINITY);
+    /// Closes the block in progress: its row, its batch means when `whole`, its sums into
+    /// the window's; at the end of a whole block (`t`), the target is checked.
+    fn close_block(&mut self, settings: &StatisticsSettings, dt: f64, whole: bool, t: f64) {
+        let b = self.block_length;
         let t0 = settings.t_start + self.block_index as f64 * b;
-        for (k, acc) in self.block.iter_mut().enumerate() {
-            let mut statistics =
-                acc.finish(self.block_steps, &names[k], dt, settings.wear_coefficient);
-            statistics.peak_force_histogram.clear();
+        let t1 = if whole {
+            t0 + b
+        } else {
+            t0 + self.block_steps as f64 * dt
+        };
+        let steps = self.block_steps;
+        for (k, ((acc, window), batches)) in self
+            .block
+            .iter_mut()
+            .zip(&mut self.window)
+            .zip(&mut self.batches)
+            .enumerate()
+        {
             self.blocks.push(BlockStatistics {
                 block: self.block_index,
+                contact: k,
                 t_start: t0,
-                t_end: t0 + b,
-                statistics,
+                t_end: t1,
+                statistics: acc.statistics(steps, dt, settings.wear_coefficient),
             });
+            if whole {
+                batches.add(&acc.batch_values(steps, dt));
+            }
+            window.merge(acc);
             acc.reset();
         }
+        self.window_steps += steps;
         self.block_steps = 0;
-        self.block_index += 1;
+        if whole && t.is_finite() && self.target_met.is_none() {
+            if let Some(target) = self.target {
+                if self.target_reached(target) {
+                    self.target_met = Some(t);
+                }
+            }
+        }
+    }
+
+    /// Every contact that wears (its wear work rate at least [`TARGET_WEAR_SHARE`] of the
+    /// largest) has a relative standard error of its wear work rate `SE/x̄ ≤ target`, over
+    /// at least [`MIN_TARGET_BATCHES`] batches.
+    fn target_reached(&self, target: f64) -> bool {
+        let mut largest = 0.0f64;
+        for m in &self.batches {
+            if m.n < MIN_TARGET_BATCHES {
+                return false;
+            }
+            largest = largest.max(m.moments(0).0);
+        }
+        largest > 0.0
+            && self.batches.iter().all(|m| {
+                let mean = m.moments(0).0;
+                mean < TARGET_WEAR_SHARE * largest || m.se(0).is_some_and(|se| se <= target * mean)
+            })
     }
 
     /// Window statistics of every contact. An impact still in progress ends with the run (at
-    /// its last opening, or at the last step if closed); a last, partial block that has steps
-    /// is closed.
+    /// its last opening, or at the last step if closed); a last block that has steps is
+    /// closed (a partial one, shorter than a block by more than a step, has its row but is
+    /// not a batch).
     pub fn finish(
         &mut self,
         settings: &StatisticsSettings,
@@ -770,62 +1236,54 @@ impl ContactStatisticsState {
                 imp.duration = end - imp.start;
                 tr.active = false;
                 if tr.in_window {
-                    self.window[k].add_impact(&imp);
-                    if let Some(block) = self.block.get_mut(k) {
-                        block.add_impact(&imp);
-                    }
+                    self.block[k].add_impact(&imp);
                     self.impacts.push(imp);
                 }
             }
         }
-        if settings.block.is_some() && self.block_steps > 0 {
-            let b = settings.block.unwrap_or(f64::INFINITY);
-            let t0 = settings.t_start + self.block_index as f64 * b;
-            let steps = self.block_steps;
-            self.close_block(settings, names, dt);
-            // a partial block ends with its last step
-            let n = self.block.len();
-            let len = self.blocks.len();
-            for row in &mut self.blocks[len - n..] {
-                row.t_end = t0 + steps as f64 * dt;
+        if self.block_steps > 0 {
+            let whole = self.block_steps as f64 + 1.0 >= self.block_length / dt;
+            let t = f64::NAN;
+            self.close_block(settings, dt, whole, t);
+        } else {
+            // impacts that ended after the window's last block
+            for (window, acc) in self.window.iter_mut().zip(&mut self.block) {
+                window.merge(acc);
+                acc.reset();
             }
         }
         self.window
             .iter()
+            .zip(&self.batches)
             .zip(names)
-            .map(|(a, name)| a.finish(self.window_steps, name, dt, settings.wear_coefficient))
+            .map(|((a, batches), name)| {
+                let mut s = a.finish(self.window_steps, name, dt, settings.wear_coefficient);
+                s.errors = batches.errors(&s, self.block_length);
+                s
+            })
             .collect()
     }
 }
 
 /// The step of contact `k` when it is closed or in an impact ([`ImpactTracker::busy`]): the
-/// tracker's step, then an impact that starts in a step of the window counts in the window
-/// (and in the block), and one that ends, having started in the window, is added to them
-/// and to the table.
-#[allow(clippy::too_many_arguments)]
+/// tracker's step, then an impact that starts in a step of the window counts in the block,
+/// and one that ends, having started in the window, is added to it and to the table.
 fn impact_step(
     k: usize,
     v: StepValues,
     rest: f64,
     in_window: bool,
     tracker: &mut ImpactTracker,
-    window: &mut ContactAccumulator,
-    mut block: Option<&mut ContactAccumulator>,
+    block: &mut ContactAccumulator,
     impacts: &mut Vec<Impact>,
 ) {
     let (started, finished) = tracker.step(k, &v, rest, in_window);
     if in_window && started {
-        window.impacts += 1;
-        if let Some(block) = block.as_deref_mut() {
-            block.impacts += 1;
-        }
+        block.impacts += 1;
     }
     if let Some(imp) = finished {
         if tracker.in_window {
-            window.add_impact(&imp);
-            if let Some(block) = block {
-                block.add_impact(&imp);
-            }
+            block.add_impact(&imp);
             impacts.push(imp);
         }
     }
@@ -887,7 +1345,7 @@ mod tests {
     }
 
     fn started(settings: &StatisticsSettings) -> ContactStatisticsState {
-        let mut state = ContactStatisticsState::new(CONTACTS, settings);
+        let mut state = ContactStatisticsState::new(CONTACTS, settings, STEPS, DT);
         state.start((0..CONTACTS).map(|k| {
             let v = values(k, 0);
             (v.penetration, v.closed)
@@ -912,25 +1370,105 @@ mod tests {
             block,
             rest_duration: 2e-3,
             wear_coefficient: 1e-15,
+            ..Default::default()
         }
     }
 
-    /// Blocks are a cut of the window: asking for them changes neither the window's
-    /// statistics nor the impacts, and without them nothing is kept for blocks.
+    /// The window's statistics do not depend on how it is cut into blocks: counts and
+    /// extrema exactly, the sums to round-off (a window sum is a sum of block sums), against
+    /// sums formed here step by step from the values; the impacts are the same.
     #[test]
     fn blocks_do_not_change_the_window() {
-        let (window, impacts, blocks) = run(&settings(None));
-        let (window_b, impacts_b, blocks_b) = run(&settings(Some(0.07)));
-        assert_eq!(window, window_b);
-        assert_eq!(impacts, impacts_b);
-        assert!(blocks.is_empty());
-        assert!(!blocks_b.is_empty());
-        assert!(window.iter().skip(1).all(|c| c.impacts > 0));
-        let state = ContactStatisticsState::new(CONTACTS, &settings(None));
-        assert!(state.block.is_empty() && state.has_contacts(CONTACTS));
-        let state = ContactStatisticsState::new(CONTACTS, &settings(Some(0.07)));
+        let s = settings(None);
+        let (window, impacts, blocks) = run(&s);
+        assert_eq!(
+            blocks.len(),
+            20 * CONTACTS,
+            "20 batches of the window by default"
+        );
+        for b in [Some(0.07), Some(0.013), Some(1.0)] {
+            let (window_b, impacts_b, _) = run(&settings(b));
+            assert_eq!(impacts, impacts_b);
+            for (w, wb) in window.iter().zip(&window_b) {
+                assert_eq!(
+                    (w.impacts, w.contact_time_fraction, w.stick_time_fraction),
+                    (wb.impacts, wb.contact_time_fraction, wb.stick_time_fraction)
+                );
+                assert_eq!(
+                    (w.normal_force_max, w.displacement_min, w.displacement_max),
+                    (
+                        wb.normal_force_max,
+                        wb.displacement_min,
+                        wb.displacement_max
+                    )
+                );
+                assert_eq!(w.peak_force_histogram, wb.peak_force_histogram);
+            }
+        }
+        for (k, w) in window.iter().enumerate() {
+            let steps: Vec<_> = (1..=STEPS)
+                .filter(|&n| s.step_in_window(n as f64 * DT, DT))
+                .map(|n| values(k, n))
+                .collect();
+            let n = steps.len() as f64;
+            let sum = |f: fn(&StepValues) -> f64| steps.iter().map(f).sum::<f64>();
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * b.abs().max(1e-300);
+            let closed =
+                |f: fn(&StepValues) -> f64| steps.iter().filter(|v| v.closed).map(f).sum::<f64>();
+            assert!(close(w.normal_force_mean, closed(|v| v.normal) / n));
+            assert!(close(
+                w.normal_force_rms,
+                (closed(|v| v.normal * v.normal) / n).sqrt()
+            ));
+            assert!(close(
+                w.wear_work_rate,
+                closed(|v| v.friction_power) * DT / (n * DT)
+            ));
+            assert!(close(w.displacement_mean, sum(|v| v.radial) / n));
+            assert!(k == 0 || w.normal_force_mean > 0.0);
+        }
+        let state = ContactStatisticsState::new(CONTACTS, &settings(None), STEPS, DT);
         assert_eq!(state.block.len(), CONTACTS);
         assert!(state.has_contacts(CONTACTS) && !state.has_contacts(CONTACTS + 1));
+        assert!((state.block_length() - 0.75 / 20.0).abs() < 1e-15);
+    }
+
+    /// The standard errors and the lag-1 autocorrelation formed from running shifted sums
+    /// are those of the block rows formed directly (two-pass).
+    #[test]
+    fn errors_are_those_of_the_block_means() {
+        for b in [None, Some(0.07), Some(0.013)] {
+            let (window, _, blocks) = run(&settings(b));
+            for (k, w) in window.iter().enumerate().skip(1) {
+                // whole blocks only: the last 0.07-s block of the 0.75-s window is partial
+                let length = blocks[0].t_end - blocks[0].t_start;
+                let rows: Vec<_> = blocks
+                    .iter()
+                    .filter(|r| r.contact == k && r.t_end - r.t_start > length - 1.5 * DT)
+                    .map(|r| &r.statistics)
+                    .collect();
+                assert_eq!(w.errors.batches, rows.len() as u64);
+                let n = rows.len() as f64;
+                let x: Vec<f64> = rows.iter().map(|r| r.wear_work_rate).collect();
+                let m = x.iter().sum::<f64>() / n;
+                let ss = x.iter().map(|x| (x - m).powi(2)).sum::<f64>();
+                let se = (ss / (n * (n - 1.0))).sqrt();
+                let r1 = x.windows(2).map(|p| (p[0] - m) * (p[1] - m)).sum::<f64>() / ss;
+                let got = w.errors.wear_work_rate_se.unwrap();
+                assert!((got - se).abs() <= 1e-9 * se, "{got} {se}");
+                let r = w.errors.batch_autocorrelation.unwrap();
+                assert!((r - r1).abs() <= 1e-9, "{r} {r1}");
+                assert_eq!(w.errors.batches_correlated, r1 > 2.0 / n.sqrt());
+                // the rms through the mean square: SE(rms) = SE(ms)/(2 rms)
+                let ms: Vec<f64> = rows.iter().map(|r| r.normal_force_rms.powi(2)).collect();
+                let mm = ms.iter().sum::<f64>() / n;
+                let se_ms =
+                    (ms.iter().map(|x| (x - mm).powi(2)).sum::<f64>() / (n * (n - 1.0))).sqrt();
+                let got = w.errors.normal_force_rms_se.unwrap();
+                let expected = se_ms / (2.0 * w.normal_force_rms);
+                assert!((got - expected).abs() <= 1e-9 * expected);
+            }
+        }
     }
 
     /// The blocks add up to the window: their steps, their impacts started; their extrema
@@ -941,7 +1479,7 @@ mod tests {
         for (k, w) in window.iter().enumerate() {
             let rows: Vec<_> = blocks
                 .iter()
-                .filter(|b| b.statistics.name == w.name)
+                .filter(|b| b.contact == k)
                 .map(|b| &b.statistics)
                 .collect();
             assert_eq!(rows.len(), 11, "contact {k}: 0.75 s in blocks of 0.07 s");

@@ -8,7 +8,7 @@
 //!   append, always gives the number of rows completely written, so that `numpy.load` reads
 //!   what a killed run had flushed;
 //! - `impacts.csv`: the per-impact table, appended as impacts end;
-//! - `blocks.csv`: the per-block statistics (when blocks are set);
+//! - `blocks.csv`: the per-block statistics (the batches of the standard errors: always);
 //! - `checkpoint.bin`: the [`Snapshot`] with the length of every file at that step, written to
 //!   a temporary name and renamed; its format is in [`CHECKPOINT_MAGIC`];
 //! - at the end, `results.npz`, packed from `series/` (copied entry by entry, never whole in
@@ -103,8 +103,9 @@ pub const RESULTS_FILE: &str = "results.npz";
 pub const CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNC";
 
 /// Format version of `checkpoint.bin` (1 was bincode, without a header; 2 counted the
-/// statistics' steps per contact and accumulated blocks when there were none).
-pub const CHECKPOINT_FORMAT: u32 = 4;
+/// statistics' steps per contact and accumulated blocks when there were none; 4 had blocks
+/// only when set, and no batch moments).
+pub const CHECKPOINT_FORMAT: u32 = 5;
 
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {
@@ -156,7 +157,9 @@ pub fn resume(
             ),
         ));
     }
-    if checkpoint.snapshot.step >= settings.steps && dir.join(RESULTS_FILE).exists() {
+    let ended =
+        checkpoint.snapshot.step >= settings.steps || checkpoint.snapshot.target_met().is_some();
+    if ended && dir.join(RESULTS_FILE).exists() {
         // killed while removing series/, after the packing: what is left is not needed
         let _ = std::fs::remove_dir_all(dir.join(SERIES_DIR));
         return Err(Error::invalid(
@@ -266,7 +269,7 @@ fn drive(
     let total = settings.steps;
     let mut termination = Termination::Completed;
     let model = files.model_contacts.clone();
-    while sim.steps_done() < total {
+    while sim.steps_done() < total && sim.target_met().is_none() {
         if let Err(d) = sim.step() {
             termination = Termination::Diverged {
                 step: d.step,
@@ -499,7 +502,7 @@ impl Files {
                 b.block,
                 b.t_start,
                 b.t_end,
-                csv_name(&s.name),
+                csv_name(self.model_contacts.get(b.contact).map_or(&s.name, |n| n)),
                 s.impacts,
                 s.impacts_per_second,
                 s.contact_time_fraction,

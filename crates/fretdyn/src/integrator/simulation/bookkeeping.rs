@@ -113,6 +113,7 @@ impl Simulation<'_> {
             stable_dt: self.stable_dt,
             wall_time,
             termination: Termination::InProgress { step: self.step },
+            target_met_at: self.statistics.target_met(),
         }
     }
 
@@ -127,10 +128,13 @@ impl Simulation<'_> {
             .statistics
             .finish(&self.settings.statistics, &self.names, dt);
         self.energy.settle();
+        let mut blocks = std::mem::take(&mut self.statistics.blocks);
+        crate::results::statistics::name_blocks(&mut blocks, &self.names);
         RunResults {
+            target_met_at: self.statistics.target_met(),
             contacts,
             impacts: std::mem::take(&mut self.statistics.impacts),
-            blocks: std::mem::take(&mut self.statistics.blocks),
+            blocks,
             recorder: self.recorder,
             solver: self.solver_stats,
             energy: self.energy,

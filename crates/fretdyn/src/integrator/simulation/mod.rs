@@ -71,6 +71,14 @@ pub struct Snapshot {
 }
 
 impl Snapshot {
+    /// The end time of the step at which the run met its target relative error, if it did
+    /// (the run ended there).
+    pub fn target_met(&self) -> Option<f64> {
+        self.statistics.target_met()
+    }
+}
+
+impl Snapshot {
     /// Binary encoding (CBOR: exact for every `f64`).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut bytes = Vec::new();
@@ -383,6 +391,13 @@ impl<'m> Simulation<'m> {
         &mut self.recorder
     }
 
+    /// End time of the step at which the target relative error of the statistics was met
+    /// (`[statistics] target_relative_error`): the run stops there.
+    #[inline]
+    pub fn target_met(&self) -> Option<f64> {
+        self.statistics.target_met()
+    }
+
     /// Statistics in progress, whose finished impacts and blocks may be drained.
     pub fn statistics_mut(&mut self) -> &mut ContactStatisticsState {
         &mut self.statistics
@@ -550,7 +565,12 @@ impl<'m> Simulation<'m> {
             external: vec![0.0; p],
             force: vec![0.0; p],
             names: model.contacts.iter().map(|c| c.name.clone()).collect(),
-            statistics: ContactStatisticsState::new(nc, &settings.statistics),
+            statistics: ContactStatisticsState::new(
+                nc,
+                &settings.statistics,
+                settings.steps,
+                settings.dt,
+            ),
             wear_map: None,
             solver_stats: SolverStatistics::default(),
             stable_dt,

@@ -68,6 +68,9 @@ pub struct RunResults {
     pub wall_time: f64,
     /// How the run ended.
     pub termination: Termination,
+    /// End time of the step at which the target relative error was met
+    /// (`[statistics] target_relative_error`), where the run stopped.
+    pub target_met_at: Option<f64>,
 }
 
 impl RunResults {
@@ -101,7 +104,7 @@ pub fn run(
     let start = Instant::now();
     let total = settings.steps;
     let mut termination = Termination::Completed;
-    while sim.steps_done() < total {
+    while sim.steps_done() < total && sim.target_met().is_none() {
         if let Err(d) = sim.step() {
             termination = d.into_termination(model);
             break;
