@@ -139,6 +139,7 @@ fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Fail
     for name in &r.contacts {
         for col in [
             "wear_work_rate",
+            "wear_work_rate_se",
             "tube_volume",
             "support_volume",
             "tube_depth",
@@ -153,9 +154,10 @@ fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Fail
     for s in &r.steps {
         let _ = write!(csv, "{:e}", s.time / YEAR);
         for c in &s.contacts {
+            let se = c.wear_work_rate_se.map(|x| format!("{x:e}")).unwrap_or_default();
             let _ = write!(
                 csv,
-                ",{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+                ",{:e},{se},{:e},{:e},{:e},{:e},{:e},{:e}",
                 c.wear_work_rate,
                 c.tube_volume,
                 c.support_volume,

@@ -112,6 +112,8 @@ pub struct ContactLife {
     /// Wear work rate of the window that drove the step (the law's work: friction or
     /// normal), W.
     pub wear_work_rate: f64,
+    /// Its standard error by batch means (THEORY §11), W; `None` without batches.
+    pub wear_work_rate_se: Option<f64>,
     /// Wear volume of the tube so far, m³.
     pub tube_volume: f64,
     /// Wear volume of the support so far, m³.
@@ -368,6 +370,7 @@ fn obstacle_wear(added: &[f64]) -> ObstacleWear {
 #[derive(Clone)]
 struct Window {
     rates: Vec<f64>,
+    errors: Vec<Option<f64>>,
     fractions: Vec<Vec<f64>>,
 }
 
@@ -403,15 +406,13 @@ fn window(
         return Ok(Err((step, contact)));
     }
     let mut rates = Vec::with_capacity(wearing.len());
+    let mut errors = Vec::with_capacity(wearing.len());
     let mut fractions = Vec::with_capacity(wearing.len());
     for &k in wearing {
-        let normal = model.wear[k].as_ref().map(|w| w.work) == Some(WearWork::Normal);
-        rates.push(
-            model.wear[k]
-                .as_ref()
-                .map_or(0.0, |w| w.work.rate(&results.contacts[k])),
-        );
-        let work = if normal {
+        let work = model.wear[k].as_ref().map(|w| w.work).unwrap_or_default();
+        rates.push(work.rate(&results.contacts[k]));
+        errors.push(work.rate_se(&results.contacts[k]));
+        let work = if work == WearWork::Normal {
             map.normal_work(k)
         } else {
             map.work(k)
@@ -423,7 +424,11 @@ fn window(
             vec![0.0; work.len()]
         });
     }
-    Ok(Ok(Window { rates, fractions }))
+    Ok(Ok(Window {
+        rates,
+        errors,
+        fractions,
+    }))
 }
 
 /// The volumes after `[t0, t1]` at the window's rates.
@@ -587,6 +592,7 @@ pub fn service_life(
     let wearing: Vec<usize> = tracks.iter().map(|c| c.k).collect();
     let zero = ContactLife {
         wear_work_rate: 0.0,
+        wear_work_rate_se: None,
         tube_volume: 0.0,
         support_volume: 0.0,
         tube_depth: 0.0,
@@ -681,6 +687,7 @@ pub fn service_life(
             }
             state.push(ContactLife {
                 wear_work_rate: rate,
+                wear_work_rate_se: w.errors[i],
                 tube_volume: a.worn.tube.iter().sum(),
                 support_volume: a.worn.support.iter().sum(),
                 tube_depth: tube,

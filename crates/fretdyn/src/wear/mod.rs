@@ -61,6 +61,17 @@ impl WearWork {
             WearWork::Normal => statistics.normal_wear_work_rate,
         }
     }
+
+    /// Its standard error by batch means (THEORY §11), when there are batches.
+    pub fn rate_se(
+        self,
+        statistics: &crate::results::statistics::ContactStatistics,
+    ) -> Option<f64> {
+        match self {
+            WearWork::Friction => statistics.errors.wear_work_rate_se,
+            WearWork::Normal => statistics.errors.normal_wear_work_rate_se,
+        }
+    }
 }
 
 impl ContactWear {
