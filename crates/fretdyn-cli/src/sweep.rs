@@ -1,6 +1,8 @@
 //! `fretdyn sweep STUDY.toml`: a parametric or Monte-Carlo study ([`fretdyn::apps::study`]) on every
-//! core, one row per finished run in `study.csv`, a progress bar, and a plot of a statistic
-//! against a parameter. Killed midway, run again: the finished rows are kept and skipped.
+//! core, one row per finished run in `study.csv`, a progress bar, a plot of a statistic
+//! against a parameter, and for a probabilistic study the percentiles across its samples
+//! (`percentiles.csv`, `percentiles.json`, docs/STUDIES.md). Killed midway, run again: the
+//! finished rows are kept and skipped.
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -76,7 +78,30 @@ pub fn main(
         );
     }
     if let Some(plot) = &s.plot {
-        plot_table(&table, &plot.x, &plot.statistic, &dir.join("study.png"))?;
+        // the lines are labelled by the values parameters and the seed, not by the draws
+        let labels: Vec<String> = s
+            .columns()
+            .into_iter()
+            .filter(|c| s.parameters[c.parameter].distribution.is_none())
+            .map(|c| c.key)
+            .chain(["seed".to_string()])
+            .collect();
+        plot_table(
+            &table,
+            &plot.x,
+            &plot.statistic,
+            &labels,
+            &dir.join("study.png"),
+        )?;
+    }
+    // percentiles across the samples, from the table (docs/STUDIES.md)
+    let report = s
+        .percentiles(&table)
+        .map_err(|e| Failure::failed(e.in_file(study)))?;
+    if let Some(report) = &report {
+        report
+            .write(&dir)
+            .map_err(|e| Failure::failed(e.to_string()))?;
     }
     if !quiet {
         outln!(
@@ -85,6 +110,14 @@ pub fn main(
             total - done,
             table.display()
         )?;
+        if let Some(report) = &report {
+            outln!(
+                "percentiles ({} rows, {:.0} % distribution-free intervals, bootstrap standard errors) in {}",
+                report.rows.len(),
+                100.0 * report.confidence,
+                dir.join("percentiles.csv").display()
+            )?;
+        }
     }
     Ok(())
 }
@@ -93,8 +126,14 @@ pub fn main(
 type Line = (String, Vec<f64>, Vec<f64>);
 
 /// One panel per contact: `statistic` against the parameter `x`, one line per combination
-/// of the other parameters and seed.
-fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(), Failure> {
+/// of the other `labels` columns (the `values` parameters and the seed).
+fn plot_table(
+    table: &Path,
+    x: &str,
+    statistic: &str,
+    labels: &[String],
+    path: &Path,
+) -> Result<(), Failure> {
     let text = std::fs::read_to_string(table)
         .map_err(|e| Failure::failed(format!("{}: {e}", table.display())))?;
     let mut lines = text.lines();
@@ -108,7 +147,7 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
     // the other parameters and the seed label the lines
     // (only those that vary)
     let others: Vec<usize> = (1..status)
-        .filter(|&i| i != xi)
+        .filter(|&i| i != xi && labels.iter().any(|l| l == header[i]))
         .filter(|&i| rows.iter().any(|r| r[i] != rows[0][i]))
         .collect();
     let contacts: Vec<(String, usize)> = header

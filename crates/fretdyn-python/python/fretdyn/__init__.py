@@ -28,7 +28,10 @@ import numpy as np
 from . import _native
 from ._native import FretdynError
 
-__all__ = ["Case", "FretdynError", "run", "stability", "sweep", "modal_structure", "__version__"]
+__all__ = [
+    "Case", "FretdynError", "run", "stability", "sweep", "percentiles", "read_table",
+    "modal_structure", "__version__",
+]
 __version__ = _native.__version__
 
 PathLike = Union[str, os.PathLike]
@@ -194,6 +197,22 @@ def sweep(study: PathLike, table: PathLike, client: Any = None, jobs: int = 0) -
             f.write(future.result() + "\n")
             f.flush()
     return len(pending)
+
+
+def percentiles(study: PathLike, table: PathLike, output: Optional[PathLike] = None) -> Optional[dict]:
+    """The percentiles (P50, P95, P99 by default) of a study's statistics across its samples,
+    from its table, as `fretdyn sweep` writes them in `percentiles.json` (docs/STUDIES.md):
+    `{"confidence", "bootstrap_resamples", "seed", "rows": [{"group", "column", "level", "n",
+    "excluded", "estimate", "ci_low", "ci_high", "ci_coverage", "bootstrap_se"}, ...]}`; the
+    interval is distribution-free (order statistics), `None` for a bound too few samples give.
+    A table written on a Dask cluster gives the same report as one written locally. With
+    `output` (a folder), `percentiles.csv` and `percentiles.json` are written there too.
+    `None` when the study asks for no percentiles (no `samples`, no `[percentiles]`)."""
+    out = _native.study_percentiles(
+        os.fspath(os.path.abspath(study)), os.fspath(table),
+        None if output is None else os.fspath(output),
+    )
+    return None if out is None else json.loads(out)
 
 
 def read_table(table: PathLike) -> dict:
