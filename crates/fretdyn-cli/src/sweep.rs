@@ -254,7 +254,7 @@ fn plot_percentiles(
         }
     }
     // (x, y) of every line, kept alive for the borrowed series
-    let mut data: Vec<(String, Vec<(String, Vec<f64>, Vec<f64>)>)> = Vec::new();
+    let mut data: Vec<(String, Vec<Line>)> = Vec::new();
     let unit = statistic_name(statistic).1;
     let value = |x: f64| {
         if unit.is_empty() {

@@ -161,7 +161,7 @@ fn percentile_intervals_cover_the_true_quantile_and_bootstrap_errors_match_the_s
     assert!((phi(xi) - 0.95).abs() < 1e-10);
     let (l, u, coverage) = order_statistic_interval(n, p, 0.95);
     let (l, u) = (l.unwrap(), u.unwrap());
-    assert!(coverage >= 0.95 && coverage < 0.99, "{coverage}");
+    assert!((0.95..0.99).contains(&coverage), "{coverage}");
     let mut covered = 0;
     let mut estimates = Vec::new();
     let mut errors = Vec::new();
