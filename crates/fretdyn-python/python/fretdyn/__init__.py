@@ -176,7 +176,10 @@ def sweep(study: PathLike, table: PathLike, client: Any = None, jobs: int = 0) -
     skipping the runs already in it. Without `client`, on this machine, `jobs` runs at a time
     (0: one per core). With a `dask.distributed.Client`, each run is a task on the cluster
     (the workers need this package and the study's files) and rows are written as tasks
-    finish. Returns the number of runs done."""
+    finish. Parameters drawn from distributions (`samples = N`, docs/STUDIES.md) take the
+    same values on the cluster as here (each draw is a function of the study seed, the sample
+    and the parameter); `percentiles(study, table)` then gives P50/P95/P99 with their errors.
+    Returns the number of runs done."""
     study = os.fspath(os.path.abspath(study))
     table = Path(table)
     if client is None:

@@ -148,35 +148,26 @@ pub struct Sampling {
     pub seed: u64,
     /// The table's parameter columns.
     pub columns: Vec<Column>,
-    /// `draws[s][c]`: value of column `c` in sample `s` (`None` for a `values` column).
-    draws: Vec<Vec<Option<toml::Value>>>,
 }
 
+/// Most samples a study may ask for (its runs are listed in memory).
+pub const MAX_SAMPLES: i64 = 100_000;
+
 impl Sampling {
-    /// Draws `samples` samples of the drawn parameters of `parameters` (columns `columns`):
-    /// column `c` of sample `s` from [`Stream::new`]`(seed, [s, parameter, element])`
-    /// (`element` only for an independent draw), a pure function of these indices.
-    fn draw(parameters: &[Parameter], columns: Vec<Column>, samples: usize, seed: u64) -> Self {
-        let draws = (0..samples)
-            .map(|s| {
-                columns
-                    .iter()
-                    .map(|c| {
-                        parameters[c.parameter].distribution.as_ref().map(|d| {
-                            let mut indices = vec![s as u64, c.parameter as u64];
-                            indices.extend(c.element.map(|e| e as u64));
-                            d.draw(&mut Stream::new(seed, &indices))
-                        })
-                    })
-                    .collect()
-            })
-            .collect();
-        Self {
-            samples,
-            seed,
-            columns,
-            draws,
-        }
+    /// The value of `column` in sample `sample` (`None` for a `values` column): drawn from
+    /// [`Stream::new`]`(seed, [sample, parameter, element])` (`element` only for an
+    /// independent draw), a pure function of these indices.
+    pub fn value(
+        &self,
+        parameters: &[Parameter],
+        sample: usize,
+        column: &Column,
+    ) -> Option<toml::Value> {
+        parameters[column.parameter].distribution.as_ref().map(|d| {
+            let mut indices = vec![sample as u64, column.parameter as u64];
+            indices.extend(column.element.map(|e| e as u64));
+            d.draw(&mut Stream::new(self.seed, &indices))
+        })
     }
 }
 
@@ -287,23 +278,19 @@ impl Study {
             .collect::<Result<Vec<_>>>()?;
         let drawn = parameters.iter().position(|p| p.distribution.is_some());
         let sampling = match (file.samples, drawn) {
-            (Some(n), _) if n < 1 => {
+            (Some(n), _) if !(1..=MAX_SAMPLES).contains(&n) => {
                 return Err(Error::invalid(
                     "samples",
                     format!(
-                        "must be at least 1, got {n}: the number of draws of the distributions"
+                        "must be between 1 and {MAX_SAMPLES}, got {n}: the number of draws of the distributions"
                     ),
                 ));
             }
-            (Some(n), Some(_)) => {
-                let columns = columns(&base, &parameters)?;
-                Some(Sampling::draw(
-                    &parameters,
-                    columns,
-                    n as usize,
-                    file.seed.unwrap_or(0),
-                ))
-            }
+            (Some(n), Some(_)) => Some(Sampling {
+                samples: n as usize,
+                seed: file.seed.unwrap_or(0),
+                columns: columns(&base, &parameters)?,
+            }),
             (Some(_), None) => {
                 return Err(Error::invalid(
                     "samples",
@@ -533,14 +520,13 @@ impl Study {
         let row = |combo: &[toml::Value], sample: Option<usize>| -> Vec<toml::Value> {
             columns
                 .iter()
-                .enumerate()
-                .map(|(c, col)| match fixed_at[col.parameter] {
+                .map(|col| match fixed_at[col.parameter] {
                     Some(i) => combo[i].clone(),
                     None => self
                         .sampling
                         .as_ref()
                         .zip(sample)
-                        .and_then(|(s, k)| s.draws[k][c].clone())
+                        .and_then(|(s, k)| s.value(&self.parameters, k, col))
                         .unwrap_or(toml::Value::Integer(0)),
                 })
                 .collect()
