@@ -32,7 +32,17 @@ pub fn quantile(sorted: &[f64], p: f64) -> f64 {
     let h = (n - 1) as f64 * p;
     let lo = (h.floor() as usize).min(n - 1);
     let hi = (lo + 1).min(n - 1);
-    sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
+    between(sorted[lo], sorted[hi], h - lo as f64)
+}
+
+/// `a + f (b − a)`, and `a` when `a = b` (two infinite values, e.g. a criterion never
+/// reached, give that infinity, not NaN).
+fn between(a: f64, b: f64, f: f64) -> f64 {
+    if a == b || f == 0.0 {
+        a
+    } else {
+        a + f * (b - a)
+    }
 }
 
 /// `ln k!` for `k = 0..=n`.
@@ -130,7 +140,7 @@ pub fn bootstrap_standard_errors(
             }
         }
         for (j, &(lo, hi, f)) in needs.iter().enumerate() {
-            let q = order[lo] + f * (order[hi] - order[lo]);
+            let q = between(order[lo], order[hi], f);
             sums[j] += q;
             squares[j] += q * q;
         }
@@ -399,6 +409,10 @@ mod tests {
         assert_eq!(quantile(&x, 0.0), 1.0);
         assert_eq!(quantile(&x, 1.0), 16.0);
         assert_eq!(quantile(&[3.0], 0.99), 3.0);
+        // infinite values (a criterion never reached) stay infinite
+        let x = [1.0, f64::INFINITY, f64::INFINITY];
+        assert_eq!(quantile(&x, 0.9), f64::INFINITY);
+        assert_eq!(quantile(&x, 0.25), f64::INFINITY);
     }
 
     #[test]

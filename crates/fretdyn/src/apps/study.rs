@@ -787,6 +787,12 @@ impl Study {
     }
 }
 
+/// The percentiles of the study file at `study` from the table at `table` (a table written by
+/// `fretdyn sweep`, or by `fretdyn.sweep` on a Dask cluster): [`Study::percentiles`].
+pub fn percentiles_from_table(study: &Path, table: &Path) -> Result<Option<PercentileReport>> {
+    Study::from_file(study)?.percentiles(table)
+}
+
 /// Column of the study table with the largest Connors ratio `U_eff/U_c` over the modes of
 /// the run's case (docs/FLOW.md; `inf` for an undamped mode in a flow; empty without
 /// `[flow]`).
