@@ -1,16 +1,19 @@
 //! `fretdyn sweep STUDY.toml`: a parametric or Monte-Carlo study ([`fretdyn::apps::study`]) on every
-//! core, one row per finished run in `study.csv`, a progress bar, and a plot of a statistic
-//! against a parameter. Killed midway, run again: the finished rows are kept and skipped.
+//! core, one row per finished run in `study.csv`, a progress bar, a plot of a statistic
+//! against a parameter, and for a probabilistic study the percentiles across its samples
+//! (`percentiles.csv`, `percentiles.json`, docs/STUDIES.md). Killed midway, run again: the
+//! finished rows are kept and skipped.
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
+use fretdyn::apps::percentiles::PercentileReport;
 use fretdyn::apps::study::{CONNORS_COLUMN, Study, connors_exceedance};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Failure;
 use crate::out::{errln, outln};
-use crate::plot::{Series, panels_plot_with_errors};
+use crate::plot::{Series, panels_plot, panels_plot_with_errors};
 
 /// Entry point of `fretdyn sweep`.
 pub fn main(
@@ -76,7 +79,33 @@ pub fn main(
         );
     }
     if let Some(plot) = &s.plot {
-        plot_table(&table, &plot.x, &plot.statistic, &dir.join("study.png"))?;
+        // the lines are labelled by the values parameters and the seed, not by the draws
+        let labels: Vec<String> = s
+            .columns()
+            .into_iter()
+            .filter(|c| s.parameters[c.parameter].distribution.is_none())
+            .map(|c| c.key)
+            .chain(["seed".to_string()])
+            .collect();
+        plot_table(
+            &table,
+            &plot.x,
+            &plot.statistic,
+            &labels,
+            &dir.join("study.png"),
+        )?;
+    }
+    // percentiles across the samples, from the table (docs/STUDIES.md)
+    let report = s
+        .percentiles(&table)
+        .map_err(|e| Failure::failed(e.in_file(study)))?;
+    if let Some(report) = &report {
+        report
+            .write(&dir)
+            .map_err(|e| Failure::failed(e.to_string()))?;
+        if let Some(statistic) = s.percentiles.as_ref().and_then(|p| p.statistics.first()) {
+            plot_percentiles(&table, report, statistic, &dir.join("percentiles.png"))?;
+        }
     }
     if !quiet {
         outln!(
@@ -85,6 +114,14 @@ pub fn main(
             total - done,
             table.display()
         )?;
+        if let Some(report) = &report {
+            outln!(
+                "percentiles ({} rows, {:.0} % distribution-free intervals, bootstrap standard errors) in {}",
+                report.rows.len(),
+                100.0 * report.confidence,
+                dir.join("percentiles.csv").display()
+            )?;
+        }
     }
     Ok(())
 }
@@ -93,8 +130,14 @@ pub fn main(
 type Line = (String, Vec<f64>, Vec<f64>);
 
 /// One panel per contact: `statistic` against the parameter `x`, one line per combination
-/// of the other parameters and seed.
-fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(), Failure> {
+/// of the other `labels` columns (the `values` parameters and the seed).
+fn plot_table(
+    table: &Path,
+    x: &str,
+    statistic: &str,
+    labels: &[String],
+    path: &Path,
+) -> Result<(), Failure> {
     let text = std::fs::read_to_string(table)
         .map_err(|e| Failure::failed(format!("{}: {e}", table.display())))?;
     let mut lines = text.lines();
@@ -108,7 +151,7 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
     // the other parameters and the seed label the lines
     // (only those that vary)
     let others: Vec<usize> = (1..status)
-        .filter(|&i| i != xi)
+        .filter(|&i| i != xi && labels.iter().any(|l| l == header[i]))
         .filter(|&i| rows.iter().any(|r| r[i] != rows[0][i]))
         .collect();
     let contacts: Vec<(String, usize)> = header
@@ -194,6 +237,130 @@ fn plot_table(table: &Path, x: &str, statistic: &str, path: &Path) -> Result<(),
         &y_label,
         &panels,
         &errors,
+    )
+    .map_err(Failure::failed)
+}
+
+/// One panel per column of `statistic` (per contact): the empirical distribution function of
+/// the completed runs' values (one line per group of the report), and each percentile of the
+/// report as a vertical segment up to its level, labelled with its interval.
+fn plot_percentiles(
+    table: &Path,
+    report: &PercentileReport,
+    statistic: &str,
+    path: &Path,
+) -> Result<(), Failure> {
+    let text = std::fs::read_to_string(table)
+        .map_err(|e| Failure::failed(format!("{}: {e}", table.display())))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let rows: Vec<Vec<&str>> = lines
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|r| r.len() == header.len())
+        .collect();
+    let at = |name: &str| header.iter().position(|h| *h == name);
+    let Some(status) = at("status") else {
+        return Ok(());
+    };
+    let mut columns: Vec<&str> = Vec::new();
+    for r in &report.rows {
+        let per_contact = r.column.ends_with(&format!(".{statistic}")) || r.column == statistic;
+        if per_contact && !columns.contains(&r.column.as_str()) {
+            columns.push(&r.column);
+        }
+    }
+    // (x, y) of every line, kept alive for the borrowed series
+    let mut data: Vec<(String, Vec<Line>)> = Vec::new();
+    let unit = statistic_name(statistic).1;
+    let value = |x: f64| {
+        if unit.is_empty() {
+            format!("{x:.3e}")
+        } else {
+            format!("{x:.3e} {unit}")
+        }
+    };
+    for column in &columns {
+        let Some(col) = at(column) else { continue };
+        let mut lines = Vec::new();
+        let mut groups: Vec<&Vec<(String, String)>> = Vec::new();
+        for r in report.rows.iter().filter(|r| r.column == *column) {
+            if !groups.contains(&&r.group) {
+                groups.push(&r.group);
+            }
+        }
+        let several = groups.len() > 1;
+        for group in groups {
+            let label = group
+                .iter()
+                .map(|(k, v)| parameter_value(k, v))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let mut x: Vec<f64> = rows
+                .iter()
+                .filter(|r| r[status] == "completed")
+                .filter(|r| group.iter().all(|(k, v)| at(k).is_some_and(|i| r[i] == v)))
+                .filter_map(|r| r[col].parse::<f64>().ok())
+                .filter(|v| v.is_finite())
+                .collect();
+            x.sort_by(f64::total_cmp);
+            let n = x.len() as f64;
+            let y: Vec<f64> = (1..=x.len()).map(|i| i as f64 / n).collect();
+            let prefix = if label.is_empty() || !several {
+                String::new()
+            } else {
+                format!("{label}: ")
+            };
+            lines.push((format!("{prefix}{} runs", x.len()), x, y));
+            for r in report
+                .rows
+                .iter()
+                .filter(|r| r.column == *column && &r.group == group && r.estimate.is_finite())
+            {
+                let bound = |b: Option<f64>| b.map_or("–".to_string(), value);
+                lines.push((
+                    format!(
+                        "{prefix}P{} = {} [{}, {}]",
+                        r.level,
+                        value(r.estimate),
+                        bound(r.ci_low),
+                        bound(r.ci_high)
+                    ),
+                    vec![r.estimate, r.estimate],
+                    vec![0.0, r.level / 100.0],
+                ));
+            }
+        }
+        let contact = column
+            .strip_suffix(&format!(".{statistic}"))
+            .unwrap_or(column);
+        data.push((contact.to_string(), lines));
+    }
+    let panels: Vec<(String, Vec<Series>)> = data
+        .iter()
+        .map(|(c, lines)| {
+            (
+                c.clone(),
+                lines
+                    .iter()
+                    .map(|(label, x, y)| Series {
+                        label: label.clone(),
+                        x,
+                        y,
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    let (name, _) = statistic_name(statistic);
+    panels_plot(
+        path,
+        &format!(
+            "Distribution of the {name} over the samples, percentiles with their {:.0} % intervals",
+            100.0 * report.confidence
+        ),
+        &statistic_label(statistic),
+        "fraction of the runs ≤ x",
+        &panels,
     )
     .map_err(Failure::failed)
 }

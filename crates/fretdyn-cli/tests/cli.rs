@@ -1237,4 +1237,66 @@ fn a_run_reports_its_standard_errors_and_warns_when_they_are_large() {
             "longer than the statistics window",
         ],
     );
+
+/// A probabilistic study: the sweep writes the drawn values in its table and the percentiles
+/// (CSV and JSON) beside it; run again, nothing is redone and the percentiles are the same.
+/// Bad input (samples = 0, an unknown distribution) is one line naming the file and the field,
+/// exit 2, nothing run.
+#[test]
+fn a_probabilistic_sweep_writes_its_percentiles() {
+    let s = Scratch::new("study_probabilistic");
+    std::fs::write(s.0.join("case.toml"), V1A).unwrap();
+    let study = "base = \"case.toml\"\nsamples = 5\nseed = 4\n\n[[parameters]]\nkey = \"contacts.*.friction.mu\"\ndistribution = { type = \"uniform\", low = 0.1, high = 0.5 }\n\n[percentiles]\nstatistics = [\"tangential_force_rms\"]\n";
+    std::fs::write(s.0.join("study.toml"), study).unwrap();
+    let out = fretdyn(&["sweep", "study.toml", "-o", "out", "-q"], &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = std::fs::read_to_string(s.0.join("out/study.csv")).unwrap();
+    assert!(table.starts_with("run,contacts.*.friction.mu,sample,seed,status,"));
+    assert_eq!(table.lines().count(), 6);
+    let csv = std::fs::read_to_string(s.0.join("out/percentiles.csv")).unwrap();
+    assert!(
+        csv.starts_with(
+            "column,level,n,excluded,estimate,ci_low,ci_high,ci_coverage,bootstrap_se\n"
+        ),
+        "{csv}"
+    );
+    // P50, P95, P99 of the one contact, 5 samples each
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+    assert!(csv.contains("plane.tangential_force_rms,95,5,0,"), "{csv}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(s.0.join("out/percentiles.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["rows"].as_array().unwrap().len(), 3);
+    let out = fretdyn(&["sweep", "study.toml", "-o", "out", "-q"], &s.0);
+    assert!(out.status.success());
+    assert_eq!(
+        std::fs::read_to_string(s.0.join("out/percentiles.csv")).unwrap(),
+        csv
+    );
+
+    for (text, needles) in [
+        (
+            study.replace("samples = 5", "samples = 0"),
+            vec!["samples:", "between 1 and 100000"],
+        ),
+        (
+            study.replace("\"uniform\", low = 0.1, high = 0.5", "\"weibull\""),
+            vec!["parameters[0].distribution.type", "\"weibull\""],
+        ),
+    ] {
+        std::fs::write(s.0.join("bad.toml"), text).unwrap();
+        let out = fretdyn(&["sweep", "bad.toml", "-o", "bad", "-q"], &s.0);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+        assert!(stderr.starts_with("error: bad.toml: "), "{stderr}");
+        for n in needles {
+            assert!(stderr.contains(n), "'{n}' not in: {stderr}");
+        }
+        assert!(!s.0.join("bad").exists(), "a run was made");
+    }
 }

@@ -306,6 +306,27 @@ fn study_local(py: Python<'_>, path: PathBuf, table: PathBuf, jobs: usize) -> Py
         .map_err(err)
 }
 
+/// The percentiles of a study's `[percentiles]` (or its defaults for a probabilistic study)
+/// from its table, as the JSON of `percentiles.json`; written into `output` (a folder) too
+/// when given. `None` when the study asks for no percentiles.
+#[pyfunction]
+#[pyo3(signature = (path, table, output = None))]
+fn study_percentiles(
+    py: Python<'_>,
+    path: PathBuf,
+    table: PathBuf,
+    output: Option<PathBuf>,
+) -> PyResult<Option<String>> {
+    let s = study(&path)?;
+    let report = py
+        .detach(|| s.percentiles(&table))
+        .map_err(|e| FretdynError::new_err(e.in_file(&path)))?;
+    if let (Some(r), Some(dir)) = (&report, &output) {
+        r.write(dir).map_err(err)?;
+    }
+    Ok(report.map(|r| r.to_json()))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FretdynError", m.py().get_type::<FretdynError>())?;
@@ -319,6 +340,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_header, m)?)?;
     m.add_function(wrap_pyfunction!(study_row, m)?)?;
     m.add_function(wrap_pyfunction!(study_local, m)?)?;
+    m.add_function(wrap_pyfunction!(study_percentiles, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -336,3 +336,57 @@ def test_the_run_dict_has_the_fluid_work_of_the_energy_balance(tmp_path):
         if lift == "0.0":
             # without the delayed lift stiffness the flow only damps: it takes energy out
             assert work < 0.0, work
+
+
+def probabilistic_study(tmp_path):
+    """The multispan tube with its plates' clearances drawn per plate and the friction drawn
+    once, 6 samples of 20 ms."""
+    (tmp_path / "tube.toml").write_text((EXAMPLES / "tube_multispan.toml").read_text())
+    path = tmp_path / "prob.toml"
+    path.write_text(
+        'base = "tube.toml"\nsamples = 6\nseed = 3\n\n[[parameters]]\n'
+        'key = "contacts.*.obstacle.clearance"\nindependent = true\n'
+        'distribution = { type = "uniform", low = 1e-5, high = 3e-5 }\n\n[[parameters]]\n'
+        'key = "contacts.*.friction.mu"\n'
+        'distribution = { type = "log_normal", median = 0.3, sigma = 0.2 }\n\n[[parameters]]\n'
+        'key = "time.duration"\nvalues = [0.02]\n\n[percentiles]\n'
+        'statistics = ["normal_force_max"]\nlevels = [50, 95]\n'
+    )
+    return path
+
+
+def rows_by_name(table):
+    """Header and rows by run index, without the wall-clock column steps_per_second."""
+    lines = Path(table).read_text().splitlines()
+    header = lines[0].split(",")
+    speed = header.index("steps_per_second")
+    body = sorted(lines[1:], key=lambda l: int(l.split(",")[0]))
+    return header, [[c for i, c in enumerate(l.split(",")) if i != speed] for l in body]
+
+
+def test_a_probabilistic_study_on_a_dask_cluster_equals_the_local_study(tmp_path):
+    """The draws depend on the study and the run index only: the rows (drawn values included)
+    and the percentiles are the same on 2 Dask workers as on this machine's cores."""
+    distributed = pytest.importorskip("dask.distributed")
+    path = probabilistic_study(tmp_path)
+    assert fretdyn.sweep(path, tmp_path / "local.csv", jobs=2) == 6
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        assert fretdyn.sweep(path, tmp_path / "dask.csv", client=client) == 6
+    local, dask = rows_by_name(tmp_path / "local.csv"), rows_by_name(tmp_path / "dask.csv")
+    assert local == dask
+    header = local[0]
+    assert "contacts.4.obstacle.clearance" in header and "sample" in header
+    t = fretdyn.read_table(tmp_path / "dask.csv")
+    c = t["contacts.0.obstacle.clearance"]
+    assert np.all((c >= 1e-5) & (c < 3e-5)) and len(set(c)) == 6
+    p_local = fretdyn.percentiles(path, tmp_path / "local.csv", output=tmp_path)
+    p_dask = fretdyn.percentiles(path, tmp_path / "dask.csv")
+    assert p_local == p_dask
+    assert (tmp_path / "percentiles.csv").exists()
+    rows = [r for r in p_local["rows"] if r["column"] == "plate1.normal_force_max"]
+    assert [r["level"] for r in rows] == [50, 95] and all(r["n"] == 6 for r in rows)
+    # the estimate is NumPy's default percentile of the column
+    assert rows[0]["estimate"] == pytest.approx(np.percentile(t["plate1.normal_force_max"], 50), rel=1e-12)
+    assert rows[1]["estimate"] == pytest.approx(np.percentile(t["plate1.normal_force_max"], 95), rel=1e-12)

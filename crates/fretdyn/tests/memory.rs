@@ -98,6 +98,8 @@ fn a_history_larger_than_the_memory_is_refused_and_a_study_keeps_none() {
         parameters: Vec::new(),
         seeds: Vec::new(),
         plot: None,
+        sampling: None,
+        percentiles: None,
     };
     let run = &study.runs()[0];
     let case = study.case(run).unwrap();

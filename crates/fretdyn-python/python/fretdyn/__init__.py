@@ -28,7 +28,10 @@ import numpy as np
 from . import _native
 from ._native import FretdynError
 
-__all__ = ["Case", "FretdynError", "run", "stability", "sweep", "modal_structure", "__version__"]
+__all__ = [
+    "Case", "FretdynError", "run", "stability", "sweep", "percentiles", "read_table",
+    "modal_structure", "__version__",
+]
 __version__ = _native.__version__
 
 PathLike = Union[str, os.PathLike]
@@ -173,7 +176,10 @@ def sweep(study: PathLike, table: PathLike, client: Any = None, jobs: int = 0) -
     skipping the runs already in it. Without `client`, on this machine, `jobs` runs at a time
     (0: one per core). With a `dask.distributed.Client`, each run is a task on the cluster
     (the workers need this package and the study's files) and rows are written as tasks
-    finish. Returns the number of runs done."""
+    finish. Parameters drawn from distributions (`samples = N`, docs/STUDIES.md) take the
+    same values on the cluster as here (each draw is a function of the study seed, the sample
+    and the parameter); `percentiles(study, table)` then gives P50/P95/P99 with their errors.
+    Returns the number of runs done."""
     study = os.fspath(os.path.abspath(study))
     table = Path(table)
     if client is None:
@@ -194,6 +200,22 @@ def sweep(study: PathLike, table: PathLike, client: Any = None, jobs: int = 0) -
             f.write(future.result() + "\n")
             f.flush()
     return len(pending)
+
+
+def percentiles(study: PathLike, table: PathLike, output: Optional[PathLike] = None) -> Optional[dict]:
+    """The percentiles (P50, P95, P99 by default) of a study's statistics across its samples,
+    from its table, as `fretdyn sweep` writes them in `percentiles.json` (docs/STUDIES.md):
+    `{"confidence", "bootstrap_resamples", "seed", "rows": [{"group", "column", "level", "n",
+    "excluded", "estimate", "ci_low", "ci_high", "ci_coverage", "bootstrap_se"}, ...]}`; the
+    interval is distribution-free (order statistics), `None` for a bound too few samples give.
+    A table written on a Dask cluster gives the same report as one written locally. With
+    `output` (a folder), `percentiles.csv` and `percentiles.json` are written there too.
+    `None` when the study asks for no percentiles (no `samples`, no `[percentiles]`)."""
+    out = _native.study_percentiles(
+        os.fspath(os.path.abspath(study)), os.fspath(table),
+        None if output is None else os.fspath(output),
+    )
+    return None if out is None else json.loads(out)
 
 
 def read_table(table: PathLike) -> dict:

@@ -18,6 +18,26 @@
 //! x = "contacts.*.obstacle.clearance"
 //! statistic = "wear_work_rate"
 //! ```
+//!
+//! A probabilistic study draws parameters from distributions ([`sampling`], `docs/STUDIES.md`):
+//!
+//! ```toml
+//! base = "tube_multispan.toml"
+//! samples = 200                      # draws; every grid point gets all of them
+//! seed = 1                           # the draws depend on (seed, sample, parameter) only
+//!
+//! [[parameters]]
+//! key = "contacts.*.obstacle.clearance"
+//! independent = true                 # one draw per contact, a column each
+//! distribution = { type = "uniform", low = 1e-4, high = 3e-4 }
+//!
+//! [percentiles]                      # optional: P50, P95, P99 and their errors
+//! statistics = ["wear_work_rate"]
+//! ```
+//!
+//! The runs are: every combination of the `values` parameters (grid or list) × every sample ×
+//! every seed, in that order; percentiles ([`percentiles`]) pool the samples and seeds of a
+//! combination.
 
 use std::collections::BTreeSet;
 use std::io::Write;
@@ -27,6 +47,8 @@ use std::time::Instant;
 
 use serde::Deserialize;
 
+use super::percentiles::{PercentileReport, PercentileRequest, percentiles_of_table};
+use super::sampling::{Distribution, Stream};
 use crate::case::{Case, check_case_text, parse_error};
 use crate::error::{Error, Result};
 use crate::integrator::simulation::{RunResults, Simulation, Termination};
@@ -42,15 +64,111 @@ pub enum Combine {
     List,
 }
 
-/// One parameter of a study: a dotted path in the case file and its values.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// One parameter of a study: a dotted path in the case file and its values, or the
+/// distribution its values are drawn from.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Parameter {
     /// Dotted path: `time.dt`, `contacts.0.friction.mu`, `contacts.*.obstacle.clearance`
     /// (`*`: every element of an array).
     pub key: String,
-    /// Values (numbers, strings or booleans, as in the case file).
+    /// Values (numbers, strings or booleans, as in the case file); empty for a drawn
+    /// parameter.
     pub values: Vec<toml::Value>,
+    /// Distribution of a drawn parameter (then `values` is empty).
+    pub distribution: Option<Distribution>,
+    /// A drawn parameter with `*` in its key: one draw per element (else one draw for all).
+    pub independent: bool,
+}
+
+impl Parameter {
+    /// A parameter taking `values` in turn.
+    pub fn with_values(key: impl Into<String>, values: Vec<toml::Value>) -> Self {
+        Self {
+            key: key.into(),
+            values,
+            distribution: None,
+            independent: false,
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawParameter {
+    key: String,
+    values: Option<Vec<toml::Value>>,
+    distribution: Option<toml::Value>,
+    independent: Option<bool>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPercentiles {
+    statistics: Option<Vec<String>>,
+    levels: Option<Vec<toml::Value>>,
+    confidence: Option<f64>,
+    bootstrap: Option<i64>,
+}
+
+/// What `[percentiles]` asks for (`docs/STUDIES.md`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PercentileSpec {
+    /// Statistics: a per-contact statistic (`wear_work_rate`: every contact's column) or any
+    /// column name of the table.
+    pub statistics: Vec<String>,
+    /// Levels, percent (default 50, 95, 99).
+    pub levels: Vec<f64>,
+    /// Confidence of the intervals (default 0.95).
+    pub confidence: f64,
+    /// Bootstrap resamples (default 1000).
+    pub bootstrap: usize,
+}
+
+/// Statistic of `[percentiles]` when the section is not given.
+pub const DEFAULT_PERCENTILE_STATISTIC: &str = "wear_work_rate";
+
+/// A column of the table that a parameter sets: its key (concrete for an independent draw),
+/// its parameter and, for an independent draw, its element.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Column {
+    /// Dotted path set by the column (the header's name).
+    pub key: String,
+    /// Index of its parameter.
+    pub parameter: usize,
+    /// Element of an independent draw (its index in the expansion of the key's `*`).
+    pub element: Option<usize>,
+}
+
+/// The draws of a probabilistic study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sampling {
+    /// Number of samples.
+    pub samples: usize,
+    /// Seed of the draws.
+    pub seed: u64,
+    /// The table's parameter columns.
+    pub columns: Vec<Column>,
+}
+
+/// Most samples a study may ask for (its runs are listed in memory).
+pub const MAX_SAMPLES: i64 = 100_000;
+
+impl Sampling {
+    /// The value of `column` in sample `sample` (`None` for a `values` column): drawn from
+    /// [`Stream::new`]`(seed, [sample, parameter, element])` (`element` only for an
+    /// independent draw), a pure function of these indices.
+    pub fn value(
+        &self,
+        parameters: &[Parameter],
+        sample: usize,
+        column: &Column,
+    ) -> Option<toml::Value> {
+        parameters[column.parameter].distribution.as_ref().map(|d| {
+            let mut indices = vec![sample as u64, column.parameter as u64];
+            indices.extend(column.element.map(|e| e as u64));
+            d.draw(&mut Stream::new(self.seed, &indices))
+        })
+    }
 }
 
 /// What `fretdyn sweep` plots.
@@ -72,8 +190,11 @@ struct StudyFile {
     #[serde(default)]
     seeds: Vec<u64>,
     #[serde(default)]
-    parameters: Vec<Parameter>,
+    parameters: Vec<RawParameter>,
     plot: Option<PlotSpec>,
+    samples: Option<i64>,
+    seed: Option<u64>,
+    percentiles: Option<RawPercentiles>,
 }
 
 /// A study: the base case as TOML, the parameters, the seeds.
@@ -91,15 +212,21 @@ pub struct Study {
     pub seeds: Vec<u64>,
     /// What to plot.
     pub plot: Option<PlotSpec>,
+    /// The draws of a probabilistic study (`samples = N`).
+    pub sampling: Option<Sampling>,
+    /// Percentiles to report (`[percentiles]`, or its defaults with `samples`).
+    pub percentiles: Option<PercentileSpec>,
 }
 
-/// One run of a study: its index, its parameter values and seed.
+/// One run of a study: its index, its parameter values, sample and seed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunSpec {
     /// Index in the study (stable: the same study gives the same indices).
     pub index: usize,
-    /// Value of each parameter.
+    /// Value of each parameter column ([`Study::columns`]).
     pub values: Vec<toml::Value>,
+    /// Sample, if the study draws parameters.
+    pub sample: Option<usize>,
     /// Seed, if the study has seeds.
     pub seed: Option<u64>,
 }
@@ -152,13 +279,70 @@ impl Study {
                 format!("{}: {}", base_path.display(), parse_error(&base_text, &e)),
             )
         })?;
+        let parameters = file
+            .parameters
+            .into_iter()
+            .enumerate()
+            .map(|(k, p)| parameter(k, p))
+            .collect::<Result<Vec<_>>>()?;
+        let drawn = parameters.iter().position(|p| p.distribution.is_some());
+        let sampling = match (file.samples, drawn) {
+            (Some(n), _) if !(1..=MAX_SAMPLES).contains(&n) => {
+                return Err(Error::invalid(
+                    "samples",
+                    format!(
+                        "must be between 1 and {MAX_SAMPLES}, got {n}: the number of draws of the distributions"
+                    ),
+                ));
+            }
+            (Some(n), Some(_)) => Some(Sampling {
+                samples: n as usize,
+                seed: file.seed.unwrap_or(0),
+                columns: columns(&base, &parameters)?,
+            }),
+            (Some(_), None) => {
+                return Err(Error::invalid(
+                    "samples",
+                    "no parameter has a distribution: give one distribution = { type = …, … } in [[parameters]], or remove samples",
+                ));
+            }
+            (None, Some(k)) => {
+                return Err(Error::invalid(
+                    "samples",
+                    format!(
+                        "missing: parameters[{k}] has a distribution: give samples = N (the number of draws) at the top of the study file"
+                    ),
+                ));
+            }
+            (None, None) => {
+                if file.seed.is_some() {
+                    return Err(Error::invalid(
+                        "seed",
+                        "is the seed of the draws and no parameter has a distribution: remove it (seeds = [...] sets the turbulence's seeds)",
+                    ));
+                }
+                None
+            }
+        };
+        let percentiles = match (file.percentiles, &sampling) {
+            (Some(raw), _) => Some(percentile_spec(raw)?),
+            (None, Some(_)) => Some(PercentileSpec {
+                statistics: vec![DEFAULT_PERCENTILE_STATISTIC.to_string()],
+                levels: vec![50.0, 95.0, 99.0],
+                confidence: 0.95,
+                bootstrap: 1000,
+            }),
+            (None, None) => None,
+        };
         let study = Self {
             base,
             base_dir: base_path.parent().unwrap_or(Path::new(".")).to_path_buf(),
             combine: file.combine,
-            parameters: file.parameters,
+            parameters,
             seeds: file.seeds,
             plot: file.plot,
+            sampling,
+            percentiles,
         };
         study.validate()?;
         Ok(study)
@@ -166,19 +350,37 @@ impl Study {
 
     fn validate(&self) -> Result<()> {
         for (k, p) in self.parameters.iter().enumerate() {
-            if p.values.is_empty() {
-                return Err(Error::invalid(
-                    format!("parameters[{k}].values"),
-                    "give at least one value",
-                ));
-            }
             // the path must exist in the base case
+            let probe_value = match (&p.values.first(), &p.distribution) {
+                (Some(v), _) => (*v).clone(),
+                (None, Some(d)) => d.draw(&mut Stream::new(0, &[])),
+                (None, None) => toml::Value::Integer(0),
+            };
             let mut probe = self.base.clone();
-            set_path(&mut probe, &p.key, &p.values[0])
+            set_path(&mut probe, &p.key, &probe_value)
                 .map_err(|m| Error::invalid(format!("parameters[{k}].key"), m))?;
         }
+        if let Some(spec) = &self.percentiles {
+            let header = self.header(&self.contact_names());
+            let columns: Vec<&str> = header.split(',').collect();
+            for (i, s) in spec.statistics.iter().enumerate() {
+                if self.percentile_columns(s, &columns).is_empty() {
+                    return Err(Error::invalid(
+                        format!("percentiles.statistics[{i}]"),
+                        format!(
+                            "'{s}' is neither a per-contact statistic nor a column of the table: use one of {TABLE_STATISTICS:?} or a column name"
+                        ),
+                    ));
+                }
+            }
+        }
         if self.combine == Combine::List {
-            let lens: BTreeSet<usize> = self.parameters.iter().map(|p| p.values.len()).collect();
+            let lens: BTreeSet<usize> = self
+                .parameters
+                .iter()
+                .filter(|p| p.distribution.is_none())
+                .map(|p| p.values.len())
+                .collect();
             if lens.len() > 1 {
                 return Err(Error::invalid(
                     "combine",
@@ -189,7 +391,9 @@ impl Study {
             }
         }
         if let Some(plot) = &self.plot {
-            if !self.parameters.iter().any(|p| p.key == plot.x) {
+            if !self.parameters.iter().any(|p| p.key == plot.x)
+                && !self.columns().iter().any(|c| c.key == plot.x)
+            {
                 return Err(Error::invalid(
                     "plot.x",
                     format!("'{}' is not one of the parameters' keys", plot.x),
@@ -205,21 +409,89 @@ impl Study {
         Ok(())
     }
 
-    /// Every run of the study, in a stable order.
+    /// The table's parameter columns: one per parameter, or one per element for an
+    /// independent draw.
+    pub fn columns(&self) -> Vec<Column> {
+        match &self.sampling {
+            Some(s) => s.columns.clone(),
+            None => self
+                .parameters
+                .iter()
+                .enumerate()
+                .map(|(k, p)| Column {
+                    key: p.key.clone(),
+                    parameter: k,
+                    element: None,
+                })
+                .collect(),
+        }
+    }
+
+    /// Columns of the table `statistic` of `[percentiles]` designates: `<contact>.<statistic>`
+    /// for every contact, or the column of that name.
+    fn percentile_columns(&self, statistic: &str, header: &[&str]) -> Vec<String> {
+        let per_contact: Vec<String> = self
+            .contact_names()
+            .iter()
+            .map(|c| format!("{c}.{statistic}"))
+            .filter(|c| header.contains(&c.as_str()))
+            .collect();
+        if !per_contact.is_empty() {
+            per_contact
+        } else if header.contains(&statistic) {
+            vec![statistic.to_string()]
+        } else {
+            Vec::new()
+        }
+    }
+
+    /// The percentiles of `[percentiles]` (module [`percentiles`](super::percentiles)) from
+    /// the table at `table`, grouped by the values of the `values` parameters; `None` when the
+    /// study asks for none.
+    pub fn percentiles(&self, table: &Path) -> Result<Option<PercentileReport>> {
+        let Some(spec) = &self.percentiles else {
+            return Ok(None);
+        };
+        let header = self.header(&self.contact_names());
+        let names: Vec<&str> = header.split(',').collect();
+        let columns = spec
+            .statistics
+            .iter()
+            .flat_map(|s| self.percentile_columns(s, &names))
+            .collect();
+        let group_by = self
+            .columns()
+            .iter()
+            .filter(|c| self.parameters[c.parameter].distribution.is_none())
+            .map(|c| c.key.clone())
+            .collect();
+        let request = PercentileRequest {
+            columns,
+            levels: spec.levels.clone(),
+            group_by,
+            confidence: spec.confidence,
+            bootstrap: spec.bootstrap,
+            seed: self.sampling.as_ref().map_or(0, |s| s.seed),
+        };
+        percentiles_of_table(table, &request).map(Some)
+    }
+
+    /// Every run of the study, in a stable order: every combination of the `values`
+    /// parameters, then every sample, then every seed.
     pub fn runs(&self) -> Vec<RunSpec> {
+        let fixed: Vec<&Parameter> = self
+            .parameters
+            .iter()
+            .filter(|p| p.distribution.is_none())
+            .collect();
         let combos: Vec<Vec<toml::Value>> = match self.combine {
             Combine::List => {
-                let n = self.parameters.first().map_or(1, |p| p.values.len());
+                let n = fixed.first().map_or(1, |p| p.values.len());
                 (0..n)
-                    .map(|i| {
-                        self.parameters
-                            .iter()
-                            .map(|p| p.values[i].clone())
-                            .collect()
-                    })
+                    .map(|i| fixed.iter().map(|p| p.values[i].clone()).collect())
                     .collect()
             }
-            Combine::Grid => self.parameters.iter().fold(vec![vec![]], |acc, p| {
+            Combine::Grid => fixed.iter().fold(vec![vec![]], |acc, p| {
                 acc.iter()
                     .flat_map(|prefix| {
                         p.values.iter().map(move |v| {
@@ -236,23 +508,60 @@ impl Study {
         } else {
             self.seeds.iter().copied().map(Some).collect()
         };
-        combos
-            .iter()
-            .flat_map(|values| seeds.iter().map(move |seed| (values.clone(), *seed)))
-            .enumerate()
-            .map(|(index, (values, seed))| RunSpec {
-                index,
-                values,
-                seed,
-            })
-            .collect()
+        let samples: Vec<Option<usize>> = match &self.sampling {
+            Some(s) => (0..s.samples).map(Some).collect(),
+            None => vec![None],
+        };
+        let columns = self.columns();
+        // position of each `values` parameter among the combination's values
+        let fixed_at: Vec<Option<usize>> = {
+            let mut k = 0;
+            self.parameters
+                .iter()
+                .map(|p| {
+                    p.distribution.is_none().then(|| {
+                        k += 1;
+                        k - 1
+                    })
+                })
+                .collect()
+        };
+        let row = |combo: &[toml::Value], sample: Option<usize>| -> Vec<toml::Value> {
+            columns
+                .iter()
+                .map(|col| match fixed_at[col.parameter] {
+                    Some(i) => combo[i].clone(),
+                    None => self
+                        .sampling
+                        .as_ref()
+                        .zip(sample)
+                        .and_then(|(s, k)| s.value(&self.parameters, k, col))
+                        .unwrap_or(toml::Value::Integer(0)),
+                })
+                .collect()
+        };
+        let mut runs = Vec::new();
+        for combo in &combos {
+            for &sample in &samples {
+                let values = row(combo, sample);
+                for &seed in &seeds {
+                    runs.push(RunSpec {
+                        index: runs.len(),
+                        values: values.clone(),
+                        sample,
+                        seed,
+                    });
+                }
+            }
+        }
+        runs
     }
 
     /// The case of one run.
     pub fn case(&self, run: &RunSpec) -> Result<Case> {
         let mut value = self.base.clone();
-        for (p, v) in self.parameters.iter().zip(&run.values) {
-            set_path(&mut value, &p.key, v).map_err(|m| Error::invalid(p.key.clone(), m))?;
+        for (c, v) in self.columns().iter().zip(&run.values) {
+            set_path(&mut value, &c.key, v).map_err(|m| Error::invalid(c.key.clone(), m))?;
         }
         if let Some(seed) = run.seed {
             if let Some(toml::Value::Array(loads)) = value.get_mut("turbulence") {
@@ -275,16 +584,22 @@ impl Study {
     /// The parameter whose value of `run` makes the case unreadable (a string where a number
     /// is expected, an unknown method…): the first that does alone.
     fn misfit(&self, run: &RunSpec, message: String) -> Error {
-        for (k, (p, v)) in self.parameters.iter().zip(&run.values).enumerate() {
+        for (c, v) in self.columns().iter().zip(&run.values) {
             let mut value = self.base.clone();
-            let alone = set_path(&mut value, &p.key, v)
+            let alone = set_path(&mut value, &c.key, v)
                 .ok()
                 .and_then(|_| toml::to_string(&value).ok())
                 .is_some_and(|text| check_case_text(&text).is_err());
             if alone {
+                let k = c.parameter;
+                let field = if self.parameters[k].distribution.is_some() {
+                    "distribution"
+                } else {
+                    "values"
+                };
                 return Error::invalid(
-                    format!("parameters[{k}].values"),
-                    format!("{} = {v} does not fit the case: {message}", p.key),
+                    format!("parameters[{k}].{field}"),
+                    format!("{} = {v} does not fit the case: {message}", c.key),
                 );
             }
         }
@@ -311,12 +626,15 @@ impl Study {
         }
     }
 
-    /// Header of the table: run, each parameter, seed, status, steps/s, then
-    /// `<contact>.<statistic>` for every contact of the base case, then
-    /// [`CONNORS_COLUMN`].
+    /// Header of the table: run, each parameter column ([`Self::columns`]), `sample` (in a
+    /// probabilistic study), seed, status, steps/s, then `<contact>.<statistic>` for every
+    /// contact of the base case, then [`CONNORS_COLUMN`].
     pub fn header(&self, contacts: &[String]) -> String {
         let mut cols = vec!["run".to_string()];
-        cols.extend(self.parameters.iter().map(|p| p.key.clone()));
+        cols.extend(self.columns().into_iter().map(|c| c.key));
+        if self.sampling.is_some() {
+            cols.push("sample".into());
+        }
         cols.extend(["seed", "status", "steps_per_second"].map(String::from));
         for c in contacts {
             for s in TABLE_STATISTICS {
@@ -333,11 +651,14 @@ impl Study {
     /// `key = value, …` of a run's parameters and its seed, for messages.
     pub fn describe(&self, run: &RunSpec) -> String {
         let mut parts: Vec<String> = self
-            .parameters
+            .columns()
             .iter()
             .zip(&run.values)
-            .map(|(p, v)| format!("{} = {v}", p.key))
+            .map(|(c, v)| format!("{} = {v}", c.key))
             .collect();
+        if let Some(sample) = run.sample {
+            parts.push(format!("sample {sample}"));
+        }
         if let Some(seed) = run.seed {
             parts.push(format!("seed = {seed}"));
         }
@@ -449,6 +770,9 @@ impl Study {
         let r = run_statistics(&case)?;
         let mut cols = vec![run.index.to_string()];
         cols.extend(run.values.iter().map(csv_value));
+        if self.sampling.is_some() {
+            cols.push(run.sample.map(|s| s.to_string()).unwrap_or_default());
+        }
         cols.push(run.seed.map(|s| s.to_string()).unwrap_or_default());
         cols.push(
             match r.termination {
@@ -477,6 +801,12 @@ impl Study {
         );
         Ok(cols.join(","))
     }
+}
+
+/// The percentiles of the study file at `study` from the table at `table` (a table written by
+/// `fretdyn sweep`, or by `fretdyn.sweep` on a Dask cluster): [`Study::percentiles`].
+pub fn percentiles_from_table(study: &Path, table: &Path) -> Result<Option<PercentileReport>> {
+    Study::from_file(study)?.percentiles(table)
 }
 
 /// Column of the study table with the largest Connors ratio `U_eff/U_c` over the modes of
@@ -630,4 +960,195 @@ fn set_path(
     }
     let parts: Vec<&str> = key.split('.').collect();
     go(root, &parts, value, key)
+}
+
+/// Checks a `[[parameters]]` entry (number `k`).
+fn parameter(k: usize, raw: RawParameter) -> Result<Parameter> {
+    let field = format!("parameters[{k}]");
+    let distribution = match (&raw.values, &raw.distribution) {
+        (Some(_), Some(_)) => {
+            return Err(Error::invalid(
+                field,
+                "gives both values and distribution: keep one (values = [...] for a grid or list, distribution = { type = …, … } for draws)",
+            ));
+        }
+        (None, None) => {
+            return Err(Error::invalid(
+                format!("{field}.values"),
+                "missing: give values = [...] or distribution = { type = …, … }",
+            ));
+        }
+        (Some(v), None) if v.is_empty() => {
+            return Err(Error::invalid(
+                format!("{field}.values"),
+                "give at least one value",
+            ));
+        }
+        (Some(_), None) => None,
+        (None, Some(d)) => Some(Distribution::from_toml(
+            d,
+            &format!("{field}.distribution"),
+        )?),
+    };
+    let independent = raw.independent.unwrap_or(false);
+    if independent && distribution.is_none() {
+        return Err(Error::invalid(
+            format!("{field}.independent"),
+            "applies to a drawn parameter (distribution = …): remove it, or give a distribution",
+        ));
+    }
+    if independent && !raw.key.split('.').any(|p| p == "*") {
+        return Err(Error::invalid(
+            format!("{field}.independent"),
+            format!(
+                "'{}' has no '*': independent = true draws each element of a '*' separately (e.g. contacts.*.obstacle.clearance)",
+                raw.key
+            ),
+        ));
+    }
+    Ok(Parameter {
+        key: raw.key,
+        values: raw.values.unwrap_or_default(),
+        distribution,
+        independent,
+    })
+}
+
+/// Checks `[percentiles]`.
+fn percentile_spec(raw: RawPercentiles) -> Result<PercentileSpec> {
+    let statistics = raw
+        .statistics
+        .unwrap_or_else(|| vec![DEFAULT_PERCENTILE_STATISTIC.to_string()]);
+    if statistics.is_empty() {
+        return Err(Error::invalid(
+            "percentiles.statistics",
+            "give at least one statistic, e.g. [\"wear_work_rate\"]",
+        ));
+    }
+    let levels = match raw.levels {
+        None => vec![50.0, 95.0, 99.0],
+        Some(levels) if levels.is_empty() => {
+            return Err(Error::invalid(
+                "percentiles.levels",
+                "give at least one level, percent: [50, 95, 99]",
+            ));
+        }
+        Some(levels) => levels
+            .iter()
+            .enumerate()
+            .map(
+                |(i, v)| match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
+                    Some(x) if x > 0.0 && x < 100.0 => Ok(x),
+                    _ => Err(Error::invalid(
+                        format!("percentiles.levels[{i}]"),
+                        format!("must be a percent strictly between 0 and 100, got {v}"),
+                    )),
+                },
+            )
+            .collect::<Result<_>>()?,
+    };
+    let confidence = raw.confidence.unwrap_or(0.95);
+    if !(confidence > 0.0 && confidence < 1.0) {
+        return Err(Error::invalid(
+            "percentiles.confidence",
+            format!("must be strictly between 0 and 1 (0.95 for 95 %), got {confidence}"),
+        ));
+    }
+    let bootstrap = match raw.bootstrap {
+        None => 1000,
+        Some(b) if b >= 2 => b as usize,
+        Some(b) => {
+            return Err(Error::invalid(
+                "percentiles.bootstrap",
+                format!("must be at least 2 resamples (1000 is usual), got {b}"),
+            ));
+        }
+    };
+    Ok(PercentileSpec {
+        statistics,
+        levels,
+        confidence,
+        bootstrap,
+    })
+}
+
+/// The parameter columns of a probabilistic study: an independent draw's key expanded into one
+/// concrete key per element of the base case (`contacts.*.x` → `contacts.0.x`, …).
+fn columns(base: &toml::Value, parameters: &[Parameter]) -> Result<Vec<Column>> {
+    let mut out = Vec::new();
+    for (k, p) in parameters.iter().enumerate() {
+        if p.independent {
+            let keys = expand(base, &p.key)
+                .map_err(|m| Error::invalid(format!("parameters[{k}].key"), m))?;
+            out.extend(keys.into_iter().enumerate().map(|(e, key)| Column {
+                key,
+                parameter: k,
+                element: Some(e),
+            }));
+        } else {
+            out.push(Column {
+                key: p.key.clone(),
+                parameter: k,
+                element: None,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Every concrete path of `key` in `root`: each `*` replaced by the indices of its array.
+fn expand(root: &toml::Value, key: &str) -> std::result::Result<Vec<String>, String> {
+    fn go(
+        v: &toml::Value,
+        parts: &[&str],
+        prefix: String,
+        key: &str,
+        out: &mut Vec<String>,
+    ) -> std::result::Result<(), String> {
+        let Some((head, rest)) = parts.split_first() else {
+            out.push(prefix);
+            return Ok(());
+        };
+        let join = |p: &str| {
+            if prefix.is_empty() {
+                p.to_string()
+            } else {
+                format!("{prefix}.{p}")
+            }
+        };
+        let missing = || format!("'{key}': '{head}' is not in the base case");
+        match v {
+            toml::Value::Array(items) if *head == "*" => {
+                if items.is_empty() {
+                    return Err(missing());
+                }
+                for (i, item) in items.iter().enumerate() {
+                    go(item, rest, join(&i.to_string()), key, out)?;
+                }
+                Ok(())
+            }
+            toml::Value::Array(items) => {
+                let i: usize = head.parse().map_err(|_| missing())?;
+                go(
+                    items.get(i).ok_or_else(missing)?,
+                    rest,
+                    join(head),
+                    key,
+                    out,
+                )
+            }
+            toml::Value::Table(t) => go(
+                t.get(*head).ok_or_else(missing)?,
+                rest,
+                join(head),
+                key,
+                out,
+            ),
+            _ => Err(missing()),
+        }
+    }
+    let parts: Vec<&str> = key.split('.').collect();
+    let mut out = Vec::new();
+    go(root, &parts, String::new(), key, &mut out)?;
+    Ok(out)
 }
