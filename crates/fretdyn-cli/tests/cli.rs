@@ -1237,6 +1237,7 @@ fn a_run_reports_its_standard_errors_and_warns_when_they_are_large() {
             "longer than the statistics window",
         ],
     );
+}
 
 /// A probabilistic study: the sweep writes the drawn values in its table and the percentiles
 /// (CSV and JSON) beside it; run again, nothing is redone and the percentiles are the same.
