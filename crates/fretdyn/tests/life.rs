@@ -217,3 +217,46 @@ fn life_input_errors_name_the_field() {
     );
     let _ = PI;
 }
+
+/// A probabilistic study whose base case has `[life]`: each sample is a service life, its row
+/// carries the depth at the target and the time to the criterion; with the friction
+/// coefficient drawn, each row's depth is the closed form at its own `W = μ N v`.
+#[test]
+fn a_probabilistic_study_of_service_lives_gives_each_sample_s_closed_form_depth() {
+    use fretdyn::apps::study::Study;
+    let dir = std::env::temp_dir().join(format!("fretdyn_life_study_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("case.toml"),
+        sliding_mass(
+            ARCHARD,
+            "target_years = 40.0\nmax_depth_change = 0.2\ncriterion_depth = 4e-4",
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("study.toml"),
+        "base = \"case.toml\"\nsamples = 4\nseed = 7\n\n[[parameters]]\nkey = \"contacts.*.friction.mu\"\ndistribution = { type = \"uniform\", low = 0.2, high = 0.4 }\n\n[percentiles]\nstatistics = [\"depth_at_target\", \"time_to_criterion\"]\n",
+    )
+    .unwrap();
+    let study = Study::from_file(&dir.join("study.toml")).unwrap();
+    assert!(study.has_life());
+    let header = study.header(&study.contact_names());
+    let cols: Vec<&str> = header.split(',').collect();
+    let at = |name: &str| cols.iter().position(|c| *c == name).unwrap();
+    for run in study.runs() {
+        let row = study.run_row(&run).unwrap();
+        let v: Vec<&str> = row.split(',').collect();
+        assert_eq!(v.len(), cols.len());
+        assert_eq!(v[at("life_end")], "completed");
+        let mu: f64 = v[at("contacts.*.friction.mu")].parse().unwrap();
+        let w = mu * 10.0 * 0.01;
+        let depth: f64 = v[at("bar.depth_at_target")].parse().unwrap();
+        let expected = depth_of_area(R, 2e-15 * w * 40.0 * YEAR / WIDTH);
+        assert!((depth - expected).abs() < 1e-6 * expected, "μ = {mu}: {depth} vs {expected}");
+        let years: f64 = v[at("bar.time_to_criterion")].parse().unwrap();
+        let tc = WIDTH * segment(R, 4e-4) / (2e-15 * w) / YEAR;
+        assert!((years - tc).abs() < 1e-6 * tc);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -644,8 +644,22 @@ impl Study {
                 cols.push(format!("{c}.{s}_se"));
             }
         }
+        if self.has_life() {
+            cols.push("life_end".into());
+            for c in contacts {
+                for s in LIFE_COLUMNS {
+                    cols.push(format!("{c}.{s}"));
+                }
+            }
+        }
         cols.push(CONNORS_COLUMN.to_string());
         cols.join(",")
+    }
+
+    /// Whether the base case has a `[life]` section: each run is then a service life
+    /// ([`crate::apps::life`]) and its row has the [`LIFE_COLUMNS`].
+    pub fn has_life(&self) -> bool {
+        self.base.get("life").is_some()
     }
 
     /// `key = value, …` of a run's parameters and its seed, for messages.
@@ -793,6 +807,9 @@ impl Study {
                 cols.push(se.as_f64().map(|x| x.to_string()).unwrap_or_default());
             }
         }
+        if let Some(life) = &case.life {
+            cols.extend(life_row(&case, life)?);
+        }
         cols.push(
             case.stability()
                 .and_then(|report| report.max_ratio())
@@ -801,6 +818,45 @@ impl Study {
         );
         Ok(cols.join(","))
     }
+}
+
+/// Per-contact columns of a study whose base case has a `[life]` section (THEORY §14.5): the
+/// tube's depth at the end of the life (m; at the target time, or where it stopped), the time
+/// to the criterion (years; `inf` when not reached), and the same by the fixed-gap
+/// extrapolation. Empty for a contact without `wear`.
+pub const LIFE_COLUMNS: [&str; 4] = [
+    "depth_at_target",
+    "time_to_criterion",
+    "depth_at_target_fixed_gap",
+    "time_to_criterion_fixed_gap",
+];
+
+/// The life columns of one run: how it ended, then [`LIFE_COLUMNS`] per contact.
+fn life_row(case: &Case, life: &crate::apps::life::LifeSettings) -> Result<Vec<String>> {
+    use crate::apps::life::{LifeEnd, YEAR, service_life};
+    let r = service_life(case, life, |_| {})?;
+    let end = match r.end {
+        LifeEnd::Completed => "completed",
+        LifeEnd::Perforated { .. } => "perforated",
+        LifeEnd::ScarLimit { .. } => "scar_limit",
+        LifeEnd::Diverged { .. } => "diverged",
+        LifeEnd::StepLimit => "step_limit",
+    };
+    let mut cols = vec![end.to_string()];
+    let last = r.steps.last().map(|s| &s.contacts);
+    let years = |t: Option<f64>| t.map_or("inf".to_string(), |t| (t / YEAR).to_string());
+    for c in &case.model.contacts {
+        match (r.contacts.iter().position(|n| n == &c.name), last) {
+            (Some(i), Some(last)) => cols.extend([
+                last[i].tube_depth.to_string(),
+                years(r.time_to_criterion[i]),
+                last[i].tube_depth_fixed_gap.to_string(),
+                years(r.time_to_criterion_fixed_gap[i]),
+            ]),
+            _ => cols.extend(std::iter::repeat_n(String::new(), LIFE_COLUMNS.len())),
+        }
+    }
+    Ok(cols)
 }
 
 /// The percentiles of the study file at `study` from the table at `table` (a table written by
