@@ -154,7 +154,10 @@ fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Fail
     for s in &r.steps {
         let _ = write!(csv, "{:e}", s.time / YEAR);
         for c in &s.contacts {
-            let se = c.wear_work_rate_se.map(|x| format!("{x:e}")).unwrap_or_default();
+            let se = c
+                .wear_work_rate_se
+                .map(|x| format!("{x:e}"))
+                .unwrap_or_default();
             let _ = write!(
                 csv,
                 ",{:e},{se},{:e},{:e},{:e},{:e},{:e},{:e}",
@@ -202,7 +205,11 @@ fn draw(path: &Path, title: &str, r: &LifeResults, criterion: Option<f64>) -> Re
             .iter()
             .map(|s| {
                 let c = &s.contacts[k];
-                if fixed { c.tube_depth_fixed_gap } else { c.tube_depth }
+                if fixed {
+                    c.tube_depth_fixed_gap
+                } else {
+                    c.tube_depth
+                }
             })
             .collect()
     };

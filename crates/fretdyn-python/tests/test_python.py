@@ -390,3 +390,34 @@ def test_a_probabilistic_study_on_a_dask_cluster_equals_the_local_study(tmp_path
     # the estimate is NumPy's default percentile of the column
     assert rows[0]["estimate"] == pytest.approx(np.percentile(t["plate1.normal_force_max"], 50), rel=1e-12)
     assert rows[1]["estimate"] == pytest.approx(np.percentile(t["plate1.normal_force_max"], 95), rel=1e-12)
+
+
+def test_a_probabilistic_service_life_study_on_dask_equals_the_local_study(tmp_path):
+    """Service lives (the base case has [life]) with the plates' clearances drawn per plate:
+    the depth columns and their percentiles are the same on 2 Dask workers as locally."""
+    distributed = pytest.importorskip("dask.distributed")
+    (tmp_path / "tube.toml").write_text((EXAMPLES / "tube_multispan_life.toml").read_text())
+    path = tmp_path / "life.toml"
+    path.write_text(
+        'base = "tube.toml"\nsamples = 4\nseed = 5\n\n[[parameters]]\n'
+        'key = "contacts.*.obstacle.clearance"\nindependent = true\n'
+        'distribution = { type = "normal", mean = 2e-4, std = 4e-5, min = 1e-4, max = 3e-4 }\n\n'
+        '[[parameters]]\nkey = "time.duration"\nvalues = [0.06]\n\n'
+        '[[parameters]]\nkey = "statistics.t_start"\nvalues = [0.01]\n\n'
+        '[percentiles]\nstatistics = ["depth_at_target"]\nlevels = [50, 95]\n'
+    )
+    assert fretdyn.sweep(path, tmp_path / "local.csv", jobs=2) == 4
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        assert fretdyn.sweep(path, tmp_path / "dask.csv", client=client) == 4
+    local, dask = rows_by_name(tmp_path / "local.csv"), rows_by_name(tmp_path / "dask.csv")
+    assert local == dask
+    t = fretdyn.read_table(tmp_path / "dask.csv")
+    assert t["life_end"] == ["completed"] * 4
+    depth = t["plate2.depth_at_target"]
+    assert np.all(depth > 0) and np.all(np.isfinite(depth))
+    p_local = fretdyn.percentiles(path, tmp_path / "local.csv")
+    assert p_local == fretdyn.percentiles(path, tmp_path / "dask.csv")
+    rows = [r for r in p_local["rows"] if r["column"] == "plate2.depth_at_target"]
+    assert rows[0]["estimate"] == pytest.approx(np.percentile(depth, 50), rel=1e-12)

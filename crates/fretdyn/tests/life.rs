@@ -253,7 +253,10 @@ fn a_probabilistic_study_of_service_lives_gives_each_sample_s_closed_form_depth(
         let w = mu * 10.0 * 0.01;
         let depth: f64 = v[at("bar.depth_at_target")].parse().unwrap();
         let expected = depth_of_area(R, 2e-15 * w * 40.0 * YEAR / WIDTH);
-        assert!((depth - expected).abs() < 1e-6 * expected, "μ = {mu}: {depth} vs {expected}");
+        assert!(
+            (depth - expected).abs() < 1e-6 * expected,
+            "μ = {mu}: {depth} vs {expected}"
+        );
         let years: f64 = v[at("bar.time_to_criterion")].parse().unwrap();
         let tc = WIDTH * segment(R, 4e-4) / (2e-15 * w) / YEAR;
         assert!((years - tc).abs() < 1e-6 * tc);

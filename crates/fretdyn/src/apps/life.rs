@@ -286,7 +286,10 @@ impl Worn {
                 tube_radius,
                 clearance,
                 ..
-            } => spread(&crescent_footprint(tube_radius, clearance, approach, n), &total),
+            } => spread(
+                &crescent_footprint(tube_radius, clearance, approach, n),
+                &total,
+            ),
             _ => spread(&[1.0], &total),
         };
         Ok(Depths {

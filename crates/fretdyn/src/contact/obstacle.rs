@@ -198,10 +198,12 @@ impl Circle {
         }
     }
 
-    /// The frame in a worn hole (module [`crate::contact::scar`]): `φ = ρ − c − d(θ)`,
-    /// `δ = φ/|∇φ|`, `n = −∇φ/|∇φ|`, `∇φ = e_ρ − (d'(θ)/ρ) e_θ`. Inside the least worn
-    /// radius `c + min d` the contact is open and its remaining clearance is measured to
-    /// that radius (no angle needed).
+    /// The frame in a worn hole (module [`crate::contact::scar`]): the signed distance to
+    /// the worn boundary `ρ = c + d(θ)` and the normal at its nearest point `b`,
+    /// `δ = ±|r − b|`, `n = (b − r)/|b − r|` outside; if the nearest point is not found, the
+    /// first-order distance `φ/|∇φ|`, `φ = ρ − c − d(θ)`. Inside the least worn radius
+    /// `c + min d` the contact is open and its clearance is measured to that radius (no angle
+    /// is needed).
     #[inline(never)]
     fn worn_frame(&self, scar: &AngularProfile, rho: f64, radial: Vector3<f64>) -> ContactFrame {
         let e_theta = self.axis.cross(&radial);
@@ -214,13 +216,35 @@ impl Circle {
             };
         }
         let e2 = self.axis.cross(&self.e1);
-        let theta = radial.dot(&e2).atan2(radial.dot(&self.e1));
-        let (depth, slope) = scar.at(theta);
-        let grad = radial - e_theta * (slope / rho);
-        let norm = grad.norm();
-        let normal = -grad / norm;
+        let (x1, x2) = (rho * radial.dot(&self.e1), rho * radial.dot(&e2));
+        let theta = x2.atan2(x1);
+        let (penetration, n2) = match scar.nearest(self.clearance, [x1, x2], theta) {
+            Some((b, db)) => {
+                let to = [b[0] - x1, b[1] - x2];
+                let dist = (to[0] * to[0] + to[1] * to[1]).sqrt();
+                // outside when r is beyond the boundary along its outward normal (db rotated)
+                let outward = [db[1], -db[0]];
+                let outside = -(to[0] * outward[0] + to[1] * outward[1]) > 0.0;
+                if dist > 0.0 {
+                    let s = if outside { 1.0 } else { -1.0 };
+                    (s * dist, [s * to[0] / dist, s * to[1] / dist])
+                } else {
+                    let l = db[0].hypot(db[1]);
+                    (0.0, [-outward[0] / l, -outward[1] / l])
+                }
+            }
+            None => {
+                let (depth, slope) = scar.at(theta);
+                let grad = radial - e_theta * (slope / rho);
+                let norm = grad.norm();
+                let n = -grad / norm;
+                let p = (rho - self.clearance - depth) / norm;
+                (p, [n.dot(&self.e1), n.dot(&e2)])
+            }
+        };
+        let normal = self.e1 * n2[0] + e2 * n2[1];
         ContactFrame {
-            penetration: (rho - self.clearance - depth) / norm,
+            penetration,
             normal,
             tangents: [self.axis.cross(&-normal), self.axis],
             velocity: Vector3::zeros(),
