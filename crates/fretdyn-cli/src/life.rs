@@ -15,7 +15,12 @@ use crate::out::{errln, outln};
 use crate::plot::{self, Series};
 
 /// Entry point of `fretdyn life`.
-pub fn main(path: &Path, output: Option<PathBuf>, plots: bool) -> Result<(), Failure> {
+pub fn main(
+    path: &Path,
+    output: Option<PathBuf>,
+    plots: bool,
+    halvings: u32,
+) -> Result<(), Failure> {
     let case = Case::from_file(path).map_err(|e| Failure::input(e.in_file(path)))?;
     for w in &case.warnings {
         errln!("warning: {w}");
@@ -93,6 +98,10 @@ pub fn main(path: &Path, output: Option<PathBuf>, plots: bool) -> Result<(), Fai
         results.wall_time,
         dir.display()
     )?;
+    if halvings > 0 {
+        convergence(&case, &life, &results, halvings, &dir, plots)
+            .map_err(|e| Failure::input(e.in_file(path)))??;
+    }
     match &results.end {
         LifeEnd::Completed => Ok(()),
         LifeEnd::Perforated { contact, time } => outln!(
@@ -128,6 +137,94 @@ pub fn main(path: &Path, output: Option<PathBuf>, plots: bool) -> Result<(), Fai
                 .unwrap_or_default()
         ))),
     }
+}
+
+/// The life again with `max_depth_change` halved `halvings` times: the tube's depth at the
+/// end of each (`convergence.csv`, `convergence.png`), the convergence check of THEORY §14.5.
+fn convergence(
+    case: &Case,
+    life: &fretdyn::apps::life::LifeSettings,
+    first: &LifeResults,
+    halvings: u32,
+    dir: &Path,
+    plots: bool,
+) -> fretdyn::Result<Result<(), Failure>> {
+    let mut fractions = vec![life.max_depth_change];
+    let mut depths: Vec<Vec<f64>> = vec![end_depths(first)];
+    let mut steps = vec![first.steps.len() - 1];
+    for h in 1..=halvings {
+        let mut refined = life.clone();
+        refined.max_depth_change = life.max_depth_change / f64::from(1u32 << h);
+        let r = service_life(case, &refined, |_| {})?;
+        if let Err(e) = outln!(
+            "max_depth_change = {}: {} life steps, tube depth at the end (m) {}",
+            refined.max_depth_change,
+            r.steps.len() - 1,
+            end_depths(&r)
+                .iter()
+                .map(|d| format!("{d:.4e}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        ) {
+            return Ok(Err(e));
+        }
+        fractions.push(refined.max_depth_change);
+        depths.push(end_depths(&r));
+        steps.push(r.steps.len() - 1);
+    }
+    let mut csv = String::from("max_depth_change,life_steps");
+    for name in &first.contacts {
+        let _ = write!(csv, ",{name}.tube_depth");
+    }
+    csv.push('\n');
+    for ((f, n), d) in fractions.iter().zip(&steps).zip(&depths) {
+        let _ = write!(csv, "{f:e},{n}");
+        for x in d {
+            let _ = write!(csv, ",{x:e}");
+        }
+        csv.push('\n');
+    }
+    let p = dir.join("convergence.csv");
+    if let Err(e) = std::fs::write(&p, csv) {
+        return Ok(Err(Failure::failed(format!("{}: {e}", p.display()))));
+    }
+    if plots {
+        // x: the number of halvings, so that the refinements are evenly spaced
+        let x: Vec<f64> = (0..fractions.len()).map(|k| k as f64).collect();
+        let columns: Vec<Vec<f64>> = (0..first.contacts.len())
+            .map(|c| depths.iter().map(|d| d[c]).collect())
+            .collect();
+        let series: Vec<Series> = first
+            .contacts
+            .iter()
+            .zip(&columns)
+            .map(|(name, y)| Series {
+                label: name.clone(),
+                x: &x,
+                y,
+            })
+            .collect();
+        let png = dir.join("convergence.png");
+        if let Err(e) = plot::line_plot(
+            &png,
+            &format!("{}: depth at the end against the life step", case.title),
+            &format!("k: max_depth_change = {} / 2^k", life.max_depth_change),
+            "tube depth (m)",
+            &series,
+            false,
+        ) {
+            return Ok(Err(Failure::failed(format!("{}: {e}", png.display()))));
+        }
+    }
+    Ok(Ok(()))
+}
+
+/// Each contact's tube depth at the end of a life.
+fn end_depths(r: &LifeResults) -> Vec<f64> {
+    r.steps
+        .last()
+        .map(|s| s.contacts.iter().map(|c| c.tube_depth).collect())
+        .unwrap_or_default()
 }
 
 fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Failure> {

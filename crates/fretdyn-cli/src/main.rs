@@ -126,6 +126,10 @@ enum Command {
         /// Do not draw life.png.
         #[arg(long)]
         no_plots: bool,
+        /// Also run the life with max_depth_change halved N times and write the depth at the
+        /// end against it (convergence.csv, convergence.png).
+        #[arg(long, default_value_t = 0)]
+        halvings: u32,
     },
     /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube (or, with
     /// --against-c, side by side with a plain C implementation of the step).
@@ -277,7 +281,8 @@ fn main() -> ExitCode {
             case,
             output,
             no_plots,
-        } => life::main(&case, output, !no_plots),
+            halvings,
+        } => life::main(&case, output, !no_plots, halvings),
         Command::Bench {
             steps,
             repeat,
