@@ -219,7 +219,8 @@ def test_a_sweep_on_a_dask_cluster_equals_the_local_sweep(tmp_path):
 def long_case():
     """The turbulent tube, 2 s: about a second of computing."""
     return fretdyn.Case.from_toml(
-        (EXAMPLES / "tube_turbulence.toml").read_text().replace("duration = 10.0", "duration = 2.0"),
+        (EXAMPLES / "tube_turbulence.toml").read_text().replace("duration = 10.0", "duration = 2.0")
+        .replace("block = 2.0", "block = 0.25"),
         EXAMPLES,
     )
 
