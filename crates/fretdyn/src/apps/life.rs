@@ -770,3 +770,37 @@ fn crossing(t0: f64, t1: f64, c: f64, depth: impl Fn(f64) -> Result<f64>) -> Res
     }
     Ok(hi)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The crescent's footprint is the lens between the tube's circle and the hole's: 1 at its
+    /// middle, and it ends where the two circles cross, `cos θ_h = (d² + R_h² − r²)/(2 d R_h)`
+    /// (the law of cosines, independent of the thickness formula).
+    #[test]
+    fn the_crescent_footprint_ends_where_the_circles_cross() {
+        let (r, c, a, n) = (9.525e-3, 2e-4, 3e-5, 3600);
+        let f = crescent_footprint(r, c, a, n);
+        assert!((f[0] - 1.0).abs() < 1e-9);
+        let (d, rh) = (c + a, r + c);
+        let half = ((d * d + rh * rh - r * r) / (2.0 * d * rh)).acos();
+        let last = f.iter().rposition(|x| *x > 0.0).unwrap();
+        let step = std::f64::consts::TAU / n as f64;
+        assert!(
+            (last as f64 * step - half).abs() <= step,
+            "{} vs {half}",
+            last as f64 * step
+        );
+        // the thickness falls from the middle to the edge
+        assert!(f.windows(2).take(last).all(|w| w[1] <= w[0]));
+        // spreading keeps the profile's peak at 1 and its symmetry
+        let mut volumes = vec![0.0; 72];
+        volumes[10] = 1.0;
+        let shape = spread(&crescent_footprint(r, c, a, 72), &volumes);
+        assert_eq!(shape[10], 1.0);
+        for j in 1..36 {
+            assert_eq!(shape[(10 + j) % 72], shape[(10 + 72 - j) % 72]);
+        }
+    }
+}
