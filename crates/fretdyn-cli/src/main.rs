@@ -131,6 +131,13 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         halvings: u32,
     },
+    /// Print a shell completion script to standard output, e.g.
+    /// `fretdyn completions bash > ~/.local/share/bash-completion/completions/fretdyn`
+    /// (zsh: to a folder of $fpath as `_fretdyn`; fish: ~/.config/fish/completions/fretdyn.fish).
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
     /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube (or, with
     /// --against-c, side by side with a plain C implementation of the step).
     Bench {
@@ -271,6 +278,11 @@ fn main() -> ExitCode {
                 .try_for_each(|f| outln!("wrote {}", f.display()))
         }),
         Command::Verify { output, quiet } => verify::main(&output, quiet),
+        Command::Completions { shell } => {
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "fretdyn", &mut script);
+            outln!("{}", String::from_utf8_lossy(&script).trim_end())
+        }
         Command::Modes {
             case,
             output,

@@ -1301,3 +1301,43 @@ fn a_probabilistic_sweep_writes_its_percentiles() {
         assert!(!s.0.join("bad").exists(), "a run was made");
     }
 }
+
+/// `fretdyn completions SHELL`: a bash script that bash parses and that completes every
+/// subcommand; an unknown shell is a one-line error listing the shells (exit 2).
+#[test]
+fn completions_are_a_script_for_the_shell() {
+    let s = Scratch::new("completions");
+    let out = fretdyn(&["completions", "bash"], &s.0);
+    assert!(out.status.success());
+    let script = String::from_utf8_lossy(&out.stdout).to_string();
+    for sub in [
+        "run",
+        "sweep",
+        "life",
+        "stability",
+        "modes",
+        "verify",
+        "bench",
+    ] {
+        assert!(
+            script.contains(&format!("fretdyn,{sub})")),
+            "{sub} not completed"
+        );
+    }
+    std::fs::write(s.0.join("fretdyn.bash"), &script).unwrap();
+    let parsed = std::process::Command::new("bash")
+        .args(["-n", "fretdyn.bash"])
+        .current_dir(&s.0)
+        .status();
+    if let Ok(status) = parsed {
+        assert!(status.success(), "bash cannot parse the script");
+    }
+    let out = fretdyn(&["completions", "tcsh"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("bash") && stderr.contains("zsh"),
+        "{stderr}"
+    );
+}
