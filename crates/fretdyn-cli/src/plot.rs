@@ -526,6 +526,7 @@ pub fn line_plot(
             y_label,
             &[(String::new(), series)],
             dashed_last,
+            &[],
             600,
         ),
     )
@@ -558,16 +559,31 @@ pub fn panels_plot_with_errors(
     let height = 60 + 300 * borrowed.len().max(1) as u32;
     finish(
         path,
-        error_panels(path, title, x_label, y_label, &borrowed, errors, height),
+        panels(path, title, x_label, y_label, &borrowed, false, errors, height),
     )
 }
 
-fn error_panels(
+/// Stacked panels, one per entry (panel title, series), sharing the x label; 300 px each.
+pub fn panels_plot(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    panels_in: &[(String, Vec<Series>)],
+) -> Result<(), String> {
+    panels_plot_with_errors(path, title, x_label, y_label, panels_in, &[])
+}
+
+/// Stacked panels; `errors[p][s][i]`, when given, is the ±error bar of point `i` of series `s`
+/// of panel `p` (the y range then holds the bars).
+#[allow(clippy::too_many_arguments)]
+fn panels(
     path: &Path,
     title: &str,
     x_label: &str,
     y_label: &str,
     panels: &[(String, &[Series])],
+    dashed_last: bool,
     errors: &[Vec<Vec<f64>>],
     height: u32,
 ) -> DrawResult<()> {
@@ -595,66 +611,6 @@ fn error_panels(
         let mut chart = frame(
             &area,
             panel_title,
-            &keys(series, false),
-            AxisSpec::new(x_label, x_range, Scale::Linear),
-            AxisSpec::new(y_label, y_range, Scale::Linear),
-        )?;
-        for (k, s) in series.iter().enumerate() {
-            let points = decimate(s.x, s.y, 4 * WIDTH as usize);
-            let (colour, _) = style_of(k, series.len(), false);
-            if points.len() <= MARKED_POINTS {
-                // the earlier series' marks larger, so that equal points all show
-                let radius = 3 + (series.len() - 1 - k).min(4) as i32;
-                let marks = points
-                    .iter()
-                    .map(|&p| Circle::new(p, radius, colour.filled()));
-                chart.draw_series(marks)?;
-            }
-            chart.draw_series(LineSeries::new(points, colour.stroke_width(1)))?;
-        }
-        for &(k, x, lo, hi) in &bars {
-            let (colour, _) = style_of(k, series.len(), false);
-            chart.draw_series(error_bar(x, lo, hi, cap, colour))?;
-        }
-    }
-    root.present()?;
-    Ok(())
-}
-
-/// Stacked panels, one per entry (panel title, series), sharing the x label; 300 px each.
-pub fn panels_plot(
-    path: &Path,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    panels_in: &[(String, Vec<Series>)],
-) -> Result<(), String> {
-    let borrowed: Vec<(String, &[Series])> = panels_in
-        .iter()
-        .map(|(t, s)| (t.clone(), s.as_slice()))
-        .collect();
-    let height = 60 + 300 * borrowed.len().max(1) as u32;
-    finish(
-        path,
-        panels(path, title, x_label, y_label, &borrowed, false, height),
-    )
-}
-
-fn panels(
-    path: &Path,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    panels: &[(String, &[Series])],
-    dashed_last: bool,
-    height: u32,
-) -> DrawResult<()> {
-    let (root, areas) = canvas(path, (WIDTH, height), title, (panels.len().max(1), 1))?;
-    for ((panel_title, series), area) in panels.iter().zip(areas) {
-        let (x_range, y_range) = ranges(series);
-        let mut chart = frame(
-            &area,
-            panel_title,
             &keys(series, dashed_last),
             AxisSpec::new(x_label, x_range, Scale::Linear),
             AxisSpec::new(y_label, y_range, Scale::Linear),
@@ -679,6 +635,10 @@ fn panels(
                 }
                 chart.draw_series(LineSeries::new(points, style))?;
             }
+        }
+        for &(k, x, lo, hi) in &bars {
+            let (colour, _) = style_of(k, series.len(), dashed_last);
+            chart.draw_series(error_bar(x, lo, hi, cap, colour))?;
         }
     }
     root.present()?;
