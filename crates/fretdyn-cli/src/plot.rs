@@ -559,7 +559,9 @@ pub fn panels_plot_with_errors(
     let height = 60 + 300 * borrowed.len().max(1) as u32;
     finish(
         path,
-        panels(path, title, x_label, y_label, &borrowed, false, errors, height),
+        panels(
+            path, title, x_label, y_label, &borrowed, false, errors, height,
+        ),
     )
 }
 

@@ -23,10 +23,11 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use crate::apps::study::statistics_run;
 use crate::case::Case;
 use crate::contact::scar::{AngularProfile, ObstacleWear};
 use crate::error::{Error, Result};
-use crate::integrator::simulation::{Simulation, Termination};
+use crate::integrator::simulation::Termination;
 use crate::model::Model;
 use crate::results::wear_map::WearMap;
 use crate::wear::{ContactWear, HoleScar, Scar, WearWork};
@@ -384,27 +385,8 @@ fn window(
     wearing: &[usize],
     bins: usize,
 ) -> Result<std::result::Result<Window, (u64, Option<String>)>> {
-    let settings = &case.settings;
-    let mut sim = Simulation::with_recorder(model, settings, 1)?;
-    sim.track_wear(bins);
-    let total = settings.steps;
-    let mut termination = Termination::Completed;
-    while sim.steps_done() < total {
-        if let Err(d) = sim.step() {
-            termination = d.into_termination(model);
-            break;
-        }
-        if sim.recorder().is_full() {
-            sim.recorder_mut().clear();
-        }
-        if sim.steps_done() % 1024 == 0 {
-            let statistics = sim.statistics_mut();
-            statistics.impacts.clear();
-            statistics.blocks.clear();
-        }
-    }
-    let map: WearMap = sim.wear_map().cloned().expect("tracked");
-    let results = sim.finish(0.0, termination);
+    let (results, map) = statistics_run(model, &case.settings, Some(bins))?;
+    let map = map.expect("tracked");
     if let Termination::Diverged { step, contact, .. } = results.termination {
         return Ok(Err((step, contact)));
     }

@@ -51,7 +51,9 @@ use super::percentiles::{PercentileReport, PercentileRequest, percentiles_of_tab
 use super::sampling::{Distribution, Stream};
 use crate::case::{Case, check_case_text, parse_error};
 use crate::error::{Error, Result};
-use crate::integrator::simulation::{RunResults, Simulation, Termination};
+use crate::integrator::simulation::{RunResults, RunSettings, Simulation, Termination};
+use crate::model::Model;
+use crate::results::wear_map::WearMap;
 
 /// How the parameters' values are combined into runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -919,13 +921,26 @@ pub fn connors_exceedance(table: &Path) -> Result<Option<ConnorsExceedance>> {
 /// does not grow with the run's length. The statistics are those of
 /// [`crate::integrator::simulation::simulate`] (running sums, which do not depend on what is recorded).
 pub fn run_statistics(case: &Case) -> Result<RunResults> {
+    statistics_run(&case.model, &case.settings, None).map(|(results, _)| results)
+}
+
+/// [`run_statistics`] of `model` with `settings`; with `wear_bins`, also where each contact's
+/// wear work was done ([`WearMap`] with that many bins around a hole, THEORY §14.3).
+pub fn statistics_run(
+    model: &Model,
+    settings: &RunSettings,
+    wear_bins: Option<usize>,
+) -> Result<(RunResults, Option<WearMap>)> {
     let start = Instant::now();
-    let mut sim = Simulation::with_recorder(&case.model, &case.settings, 1)?;
-    let total = case.settings.steps;
+    let mut sim = Simulation::with_recorder(model, settings, 1)?;
+    if let Some(bins) = wear_bins {
+        sim.track_wear(bins);
+    }
+    let total = settings.steps;
     let mut termination = Termination::Completed;
     while sim.steps_done() < total {
         if let Err(d) = sim.step() {
-            termination = d.into_termination(&case.model);
+            termination = d.into_termination(model);
             break;
         }
         if sim.recorder().is_full() {
@@ -937,7 +952,8 @@ pub fn run_statistics(case: &Case) -> Result<RunResults> {
             statistics.blocks.clear();
         }
     }
-    Ok(sim.finish(start.elapsed().as_secs_f64(), termination))
+    let map = sim.wear_map().cloned();
+    Ok((sim.finish(start.elapsed().as_secs_f64(), termination), map))
 }
 
 fn csv_value(v: &toml::Value) -> String {
