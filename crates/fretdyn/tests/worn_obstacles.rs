@@ -140,9 +140,9 @@ fn a_worn_hole_gives_the_distance_and_normal_of_its_boundary() {
         .worn(&ObstacleWear::Angular(profile.clone()), "h")
         .unwrap();
     let mut worst = (0.0f64, 0.0f64);
-    // the boundary has corners at the bins' centres (the profile is linear in between):
-    // points midway between them, within 5e-7 m of the boundary, have their nearest boundary
-    // point on the same piece (the corners are 1.1e-5 m away along it)
+    // the boundary's curvature jumps at the bins' centres (a cubic on each piece): points
+    // midway between them, within 5e-7 m of the boundary, have their nearest boundary point on
+    // the same piece (the centres are 1.1e-5 m away along it)
     let h = TAU / bins as f64;
     for k in 5..22 {
         let th = k as f64 * h;
@@ -222,19 +222,7 @@ fn worn_holes_keep_the_energy_balance() {
     let round = fretdyn::integrator::simulation::simulate(&case.model, &case.settings).unwrap();
     let mut worn = case.model.clone();
     // two crescents 40 µm deep, ±40° wide, at the ends of the forcing's stroke (31°, 211°)
-    let bins = 72;
-    let depths: Vec<f64> = (0..bins)
-        .map(|k| {
-            let th = (k as f64 + 0.5) * TAU / bins as f64;
-            [31f64.to_radians(), 211f64.to_radians()]
-                .iter()
-                .map(|c| {
-                    let u = ((th - c + 0.5 * TAU).rem_euclid(TAU) - 0.5 * TAU) / 40f64.to_radians();
-                    4e-5 * (1.0 - u * u).max(0.0)
-                })
-                .fold(0.0, f64::max)
-        })
-        .collect();
+    let depths = two_crescents(72);
     let profile = ObstacleWear::Angular(AngularProfile::new(depths).unwrap());
     for c in &mut worn.contacts {
         c.obstacle = c.obstacle.worn(&profile, &c.name).unwrap();
@@ -261,19 +249,7 @@ fn worn_holes_keep_the_energy_balance() {
 #[test]
 fn a_worn_hole_s_penetration_is_a_signed_distance() {
     let c = 2e-4;
-    let bins = 72;
-    let depths: Vec<f64> = (0..bins)
-        .map(|k| {
-            let th = (k as f64 + 0.5) * TAU / bins as f64;
-            [31f64.to_radians(), 211f64.to_radians()]
-                .iter()
-                .map(|m| {
-                    let u = ((th - m + 0.5 * TAU).rem_euclid(TAU) - 0.5 * TAU) / 40f64.to_radians();
-                    4e-5 * (1.0 - u * u).max(0.0)
-                })
-                .fold(0.0, f64::max)
-        })
-        .collect();
+    let depths = two_crescents(72);
     let hole = Obstacle::Circle(Circle::new(Vector3::zeros(), Vector3::x(), c, "h").unwrap());
     let worn = hole
         .worn(
@@ -312,4 +288,21 @@ fn a_worn_hole_s_penetration_is_a_signed_distance() {
     eprintln!("Lipschitz {worst_lip}, gradient {worst_grad}");
     assert!(worst_lip < 1.0 + 1e-4, "{worst_lip}");
     assert!(worst_grad < 1e-4, "{worst_grad}");
+}
+
+/// 72 bins of two crescent-like scars 40 µm deep and ±40° wide at the ends of the multi-span
+/// tube's stroke (31°, 211°).
+fn two_crescents(bins: usize) -> Vec<f64> {
+    (0..bins)
+        .map(|k| {
+            let th = (k as f64 + 0.5) * TAU / bins as f64;
+            [31f64.to_radians(), 211f64.to_radians()]
+                .iter()
+                .map(|m| {
+                    let u = ((th - m + 0.5 * TAU).rem_euclid(TAU) - 0.5 * TAU) / 40f64.to_radians();
+                    4e-5 * (1.0 - u * u).max(0.0)
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect()
 }
