@@ -56,6 +56,9 @@ pub struct TangentialProblem {
     /// Per slot, the Newton start of its exact slip solve within the step
     /// ([`crate::contact::friction::local_solve_block`]); reset by [`Self::assemble`].
     newton: Vec<Cell<f64>>,
+    /// Per slot, the right-hand side `c_k` of its local solve in the last Gauss–Seidel sweep
+    /// and the change of its `λ_k` in that sweep ([`Self::record_sweep`]).
+    sweep: Vec<Cell<[Vector2<f64>; 2]>>,
     stride: usize,
     /// The closed contacts of the last singularity test whose `H` was made of fixed rows
     /// only, and its answer ([`Self::is_singular`]).
@@ -82,6 +85,7 @@ impl TangentialProblem {
             diagonal: vec![DiagonalBlock::default(); contacts],
             diagonal_fixed: vec![DiagonalBlock::default(); contacts],
             newton: vec![Cell::new(f64::NAN); contacts],
+            sweep: vec![Cell::new([Vector2::zeros(); 2]); contacts],
             stride: rows,
             singular_for: Vec::with_capacity(contacts),
             singular: None,
@@ -349,6 +353,46 @@ impl TangentialProblem {
     /// of a sliding contact; it is 0 exactly when λ satisfies Coulomb's law. Returned as
     /// `‖r‖ / max(‖λ‖, max_i s_i)`, relative to the friction forces at stake.
     pub fn natural_map_residual(&self, lambda: &[Vector2<f64>], slide: &[Slide]) -> f64 {
+        self.natural_map(lambda, slide, |k| self.residual_velocity(k, lambda))
+    }
+
+    /// Records slot `k`'s local solve in a Gauss–Seidel sweep: its right-hand side `c_k`
+    /// (the other contacts' λ as they were then) and the change of its `λ_k`.
+    #[inline]
+    pub fn record_sweep(&self, k: usize, rhs: Vector2<f64>, change: Vector2<f64>) {
+        self.sweep[k].set([rhs, change]);
+    }
+
+    /// [`Self::natural_map_residual`] at the end of a Gauss–Seidel sweep whose every local
+    /// solve was recorded ([`Self::record_sweep`]), without forming `Hλ` again: slot `k`'s
+    /// right-hand side saw the new λ of the slots before it and the old λ of those after it,
+    /// so `w_k = c_k − H_kk λ_k − Σ_{j>k} H_kj Δλ_j` (exactly `w_k` of
+    /// [`Self::residual_velocity`] up to the order of the sums; for a single contact, the
+    /// same operations).
+    pub fn natural_map_residual_after_sweep(
+        &self,
+        lambda: &[Vector2<f64>],
+        slide: &[Slide],
+    ) -> f64 {
+        let m = self.slots.len().min(lambda.len());
+        self.natural_map(lambda, slide, |k| {
+            let [c, _] = self.sweep[k].get();
+            let mut w = c - self.diagonal[k].h * lambda[k];
+            for j in k + 1..m {
+                w -= self.block(k, j) * self.sweep[j].get()[1];
+            }
+            w
+        })
+    }
+
+    /// The natural-map residual with the residual velocities `w(k) = (b − Hλ)_k`.
+    #[inline]
+    fn natural_map(
+        &self,
+        lambda: &[Vector2<f64>],
+        slide: &[Slide],
+        w: impl Fn(usize) -> Vector2<f64>,
+    ) -> f64 {
         let mut r2 = 0.0;
         let mut l2 = 0.0;
         let mut s_max = 0.0f64;
@@ -358,7 +402,7 @@ impl TangentialProblem {
                 Slide::Stick => slot.s_static,
                 Slide::Slip => slot.s_dynamic,
             };
-            let z = lambda[k] + self.residual_velocity(k, lambda) * rho;
+            let z = lambda[k] + w(k) * rho;
             let n2 = z.norm_squared();
             let projected = if n2 > s * s { z * (s / n2.sqrt()) } else { z };
             r2 += (lambda[k] - projected).norm_squared();

@@ -233,6 +233,7 @@ fn disk_boundary_solve(
     let (q, eigenvalues) = block.eigen.unwrap_or_else(|| symmetric_eigen2(h));
     let hs = [s * eigenvalues[0], s * eigenvalues[1]];
     let cp = q.transpose() * c;
+    let c2 = [cp[0] * cp[0], cp[1] * cp[1]];
     // u(t) in the eigenbasis; a component of c that is exactly 0 stays 0 (also at t = lower).
     let u_of = |t: f64| {
         let part = |k: usize| {
@@ -253,8 +254,8 @@ fn disk_boundary_solve(
     } else {
         // The root lies in [|c| − s h_max, |c| − s h_min]; start from |c| minus the mean of
         // s h_k weighted by c's components, exact to first order in s h/t (a fast slip).
-        let c2 = cp[0] * cp[0] + cp[1] * cp[1];
-        let first_order = c2.sqrt() - (cp[0] * cp[0] * hs[0] + cp[1] * cp[1] * hs[1]) / c2;
+        let n2 = c2[0] + c2[1];
+        let first_order = n2.sqrt() - (c2[0] * hs[0] + c2[1] * hs[1]) / n2;
         let t = lower
             .max(c.norm() - hs[0].max(hs[1]))
             .max(0.0)
@@ -268,16 +269,21 @@ fn disk_boundary_solve(
     };
     for _ in 0..100 {
         // φ = 1/|u| − 1, φ' = Σ u_k²/(s h_k + t) / |u|³, so the Newton step φ/φ' is
-        // |u|²(1 − |u|) / Σ u_k²/(s h_k + t): three divisions.
-        let (r0, r1) = (1.0 / (hs[0] + t), 1.0 / (hs[1] + t));
-        let (a, b) = (
-            if cp[0] == 0.0 { 0.0 } else { cp[0] * r0 },
-            if cp[1] == 0.0 { 0.0 } else { cp[1] * r1 },
-        );
-        let n2 = a * a + b * b;
-        let step = n2 * (1.0 - n2.sqrt()) / (a * a * r0 + b * b * r1);
+        // |u|²(1 − |u|) / Σ u_k²/(s h_k + t). With e_k = s h_k + t, D = e₀e₁,
+        // N = c₀²e₁² + c₁²e₀² = D²|u|² and M = c₀²e₁³ + c₁²e₀³, it is N (D − √N) / M:
+        // one square root and one division on the dependent chain (the form with u needs
+        // three divisions).
+        let (e0, e1) = (hs[0] + t, hs[1] + t);
+        let (w0, w1) = (c2[0] * e1, c2[1] * e0);
+        let n = w0 * e1 + w1 * e0;
+        let m = w0 * e1 * e1 + w1 * e0 * e0;
+        let mut step = n * (e0 * e1 - n.sqrt()) / m;
         if !step.is_finite() {
-            break;
+            // overflow of the products, or a pole (e_k = 0 where c_k = 0): the form with u
+            step = newton_step_direct(&cp, &hs, t);
+            if !step.is_finite() {
+                break;
+            }
         }
         let next = t - step;
         // Stay in the domain t > lower (a flat tangent far above the root could leave it).
@@ -294,17 +300,39 @@ fn disk_boundary_solve(
         }
     }
     newton.set(t);
-    let [a, b] = u_of(t);
-    let u = q * Vector2::new(a, b);
-    let n = u.norm();
-    if n.is_finite() && n > 0.0 {
-        u * (s / n)
+    // u(t) ∥ (c₀ e₁, c₁ e₀) (times 1/D > 0): λ = s u/|u| needs no division by e_k
+    let (e0, e1) = (hs[0] + t, hs[1] + t);
+    let v = q * Vector2::new(cp[0] * e1, cp[1] * e0);
+    let n2 = v.norm_squared();
+    if n2.is_finite() && n2 > 0.0 && e0 > 0.0 && e1 > 0.0 {
+        v * (s / n2.sqrt())
     } else {
-        // Degenerate input (c = 0 cannot slide): project the free solution radially.
-        let free = solve2(h, c);
-        let nf = free.norm();
-        if nf > 0.0 { free * (s / nf) } else { free }
+        let [a, b] = u_of(t);
+        let u = q * Vector2::new(a, b);
+        let n = u.norm();
+        if n.is_finite() && n > 0.0 {
+            u * (s / n)
+        } else {
+            // Degenerate input (c = 0 cannot slide): project the free solution radially.
+            let free = solve2(h, c);
+            let nf = free.norm();
+            if nf > 0.0 { free * (s / nf) } else { free }
+        }
     }
+}
+
+/// The Newton step of [`disk_boundary_solve`] in the form with `u = (c_k/(s h_k + t))`:
+/// `|u|²(1 − |u|) / Σ u_k²/(s h_k + t)`, a component of `c` that is exactly 0 contributing 0
+/// (also on its pole).
+#[cold]
+fn newton_step_direct(cp: &Vector2<f64>, hs: &[f64; 2], t: f64) -> f64 {
+    let (r0, r1) = (1.0 / (hs[0] + t), 1.0 / (hs[1] + t));
+    let (a, b) = (
+        if cp[0] == 0.0 { 0.0 } else { cp[0] * r0 },
+        if cp[1] == 0.0 { 0.0 } else { cp[1] * r1 },
+    );
+    let n2 = a * a + b * b;
+    n2 * (1.0 - n2.sqrt()) / (a * a * r0 + b * b * r1)
 }
 
 /// Eigen-decomposition `H = Q diag(h) Qᵀ` of a symmetric 2 × 2 matrix, in closed form: the
@@ -445,5 +473,74 @@ mod tests {
         let u = (h * s + Matrix2::identity() * lo).lu().solve(&c).unwrap();
         let reference = u * (s / u.norm());
         assert!((lam - reference).norm() < 1e-13 * s, "{lam} vs {reference}");
+    }
+
+    /// `c` exactly along an eigenvector of `H` (one component of `c` is 0 in the eigenbasis,
+    /// also with an anisotropy of 10¹²): the slip solution is `λ = s c/|c|`, `t = |c| − s h` of that
+    /// eigenvector, in closed form.
+    #[test]
+    fn exact_local_solve_along_an_eigenvector() {
+        let s = 0.5;
+        for (h, c) in [
+            (Matrix2::new(1.0, 0.0, 0.0, 4.0), Vector2::new(3.0, 0.0)),
+            (Matrix2::new(1.0, 0.0, 0.0, 4.0), Vector2::new(0.0, -7.0)),
+            (Matrix2::new(1.0, 0.0, 0.0, 1e-12), Vector2::new(2.0, 0.0)),
+            (Matrix2::new(1e-12, 0.0, 0.0, 1.0), Vector2::new(2.0, 0.0)),
+        ] {
+            let (lam, st) = local_solve(&h, &c, s, s, LocalSolve::Exact);
+            assert_eq!(st, Slide::Slip, "{h} {c}");
+            let expected = c * (s / c.norm());
+            assert!(
+                (lam - expected).norm() <= 1e-15 * s,
+                "{h} {c}: {lam} vs {expected}"
+            );
+        }
+    }
+
+    /// Random blocks (anisotropy up to 10⁶, any orientation) and right-hand sides: the exact
+    /// slip solution against the root of `|(sH + tI)⁻¹c| = 1` found by bisection in the
+    /// original basis (no eigen-decomposition, no Newton).
+    #[test]
+    fn exact_local_solve_matches_bisection_on_random_blocks() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let angle = std::f64::consts::PI * uniform();
+            let (cs, sn) = (angle.cos(), angle.sin());
+            let q = Matrix2::new(cs, -sn, sn, cs);
+            let h0 = 10f64.powf(3.0 * uniform() - 1.0);
+            let h1 = h0 * 10f64.powf(-6.0 * uniform());
+            let h = q * Matrix2::new(h0, 0.0, 0.0, h1) * q.transpose();
+            let h = 0.5 * (h + h.transpose());
+            let c = Vector2::new(uniform() - 0.5, uniform() - 0.5) * 10f64.powf(4.0 * uniform());
+            // a slip: s below |H⁻¹c|
+            let free = inverse2(&h) * c;
+            let s = free.norm() * (0.05 + 0.9 * uniform());
+            let (lam, st) = local_solve(&h, &c, s, s, LocalSolve::Exact);
+            assert_eq!(st, Slide::Slip);
+            let size = |t: f64| {
+                (h * s + Matrix2::identity() * t)
+                    .lu()
+                    .solve(&c)
+                    .map_or(f64::INFINITY, |u| u.norm())
+            };
+            // |u(t)| decreases from ∞ at the pole; the root is below |c|
+            let (mut lo, mut hi) = (-s * h1.min(h0), c.norm());
+            for _ in 0..300 {
+                let mid = 0.5 * (lo + hi);
+                if size(mid) > 1.0 { lo = mid } else { hi = mid }
+            }
+            let u = (h * s + Matrix2::identity() * hi).lu().solve(&c).unwrap();
+            let reference = u * (s / u.norm());
+            assert!(
+                (lam - reference).norm() <= 1e-9 * s,
+                "H = {h}, c = {c}, s = {s}: {lam} vs {reference}"
+            );
+        }
     }
 }

@@ -47,7 +47,9 @@ pub fn solve(
                 settings.local_solve,
                 problem.newton_start(k),
             );
-            diff2 += (new - lambda[k]).norm_squared();
+            let change = new - lambda[k];
+            problem.record_sweep(k, c, change);
+            diff2 += change.norm_squared();
             norm2 += new.norm_squared();
             lambda[k] = new;
             slide[k] = st;
@@ -56,7 +58,7 @@ pub fn solve(
             // The radial local solve does not satisfy Coulomb's law when H_ii is not
             // isotropic: its fixed point is not a zero of the residual, so only the change
             // test applies to it.
-            let r = problem.natural_map_residual(&lambda[..m], &slide[..m]);
+            let r = problem.natural_map_residual_after_sweep(&lambda[..m], &slide[..m]);
             residual = Some(r);
             if r <= settings.residual_tolerance || settings.local_solve == LocalSolve::Radial {
                 return Sweeps {
