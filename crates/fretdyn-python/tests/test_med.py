@@ -379,7 +379,7 @@ def test_names_given_twice_and_unused_rotations(tmp_path):
 
 def test_a_dict_case_keeps_every_bit_of_its_floats():
     # basis.structure() goes through Case.from_dict (JSON): every float must come back as it
-    # was (serde_json's float_roundtrip; without it about one in five moved by an ulp)
+    # was (serde_json's float_roundtrip; without it about one in ten moved by an ulp)
     v = np.random.default_rng(7).random(2000) * 1e3
     structure = {"type": "modal", "frequencies_hz": v.tolist(), "damping_ratio": 0.0,
                  "points": [{"name": "PA", "rows": np.zeros((3, len(v))).tolist()}]}
