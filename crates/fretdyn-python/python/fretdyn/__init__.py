@@ -27,6 +27,7 @@ import numpy as np
 
 from . import _native
 from ._native import FretdynError
+from . import med  # modal bases from Code_Aster's MED files (docs/MED.md)
 
 __all__ = [
     "Case", "FretdynError", "run", "stability", "sweep", "percentiles", "read_table",
