@@ -27,6 +27,20 @@ pub(crate) trait Lanes: Copy {
     /// row, `out.len()` rows), each summed exactly as [`Self::dot`] sums it: one pass over `x`
     /// serves four rows.
     fn dots(a: &[f64], x: &[f64], out: &mut [f64]);
+    /// Steps 1–2 of central differences: `q_i += Δt v_i + (h Δt) a_i`, `vs_i = v_i + h a_i`
+    /// (slices of equal length; elementwise, so every width gives the same bits).
+    fn predict(q: &mut [f64], vs: &mut [f64], v: &[f64], a: &[f64], dt: f64, h: f64);
+    /// Step 5: `out_i = ai_i ((f_i − w2_i q_i) − c_i vs_i)` (slices of equal length).
+    #[allow(clippy::too_many_arguments)]
+    fn free_acceleration(
+        out: &mut [f64],
+        ai: &[f64],
+        f: &[f64],
+        w2: &[f64],
+        q: &[f64],
+        c: &[f64],
+        vs: &[f64],
+    );
     /// Writes `v_i = vs_i + h a_i` to `v` and returns `(½ Σ (v_i² + w2_i q_i²), Σ c_i v_i²,
     /// Σ f_i v_i)`: the velocity update of central differences with the structure's energy,
     /// its damping power and the power of the force `f` (slices of equal length).
@@ -118,6 +132,34 @@ impl Lanes for Portable {
     }
 
     #[inline(always)]
+    fn predict(q: &mut [f64], vs: &mut [f64], v: &[f64], a: &[f64], dt: f64, h: f64) {
+        let p = q.len();
+        let (vs, v, a) = (&mut vs[..p], &v[..p], &a[..p]);
+        let hdt = h * dt;
+        for i in 0..p {
+            q[i] += dt * v[i] + hdt * a[i];
+            vs[i] = v[i] + h * a[i];
+        }
+    }
+
+    #[inline(always)]
+    fn free_acceleration(
+        out: &mut [f64],
+        ai: &[f64],
+        f: &[f64],
+        w2: &[f64],
+        q: &[f64],
+        c: &[f64],
+        vs: &[f64],
+    ) {
+        let p = out.len();
+        let (ai, f, w2, q, c, vs) = (&ai[..p], &f[..p], &w2[..p], &q[..p], &c[..p], &vs[..p]);
+        for i in 0..p {
+            out[i] = ai[i] * (f[i] - w2[i] * q[i] - c[i] * vs[i]);
+        }
+    }
+
+    #[inline(always)]
     fn correct_with_energy(
         v: &mut [f64],
         vs: &[f64],
@@ -188,6 +230,26 @@ impl Lanes for Avx2 {
     }
 
     #[inline(always)]
+    fn predict(q: &mut [f64], vs: &mut [f64], v: &[f64], a: &[f64], dt: f64, h: f64) {
+        // SAFETY: as above
+        unsafe { avx2::predict(q, vs, v, a, dt, h) }
+    }
+
+    #[inline(always)]
+    fn free_acceleration(
+        out: &mut [f64],
+        ai: &[f64],
+        f: &[f64],
+        w2: &[f64],
+        q: &[f64],
+        c: &[f64],
+        vs: &[f64],
+    ) {
+        // SAFETY: as above
+        unsafe { avx2::free_acceleration(out, ai, f, w2, q, c, vs) }
+    }
+
+    #[inline(always)]
     fn correct_with_energy(
         v: &mut [f64],
         vs: &[f64],
@@ -211,6 +273,7 @@ mod avx2 {
     use std::arch::x86_64::{
         __m256d, __m256i, _mm256_add_pd, _mm256_loadu_pd, _mm256_loadu_si256, _mm256_maskload_pd,
         _mm256_maskstore_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+        _mm256_sub_pd,
     };
 
     use super::combine;
@@ -379,6 +442,121 @@ mod avx2 {
         }
     }
 
+    /// [`super::Portable::predict`] on AVX2: four modes at a time, the last `p mod 4` by
+    /// one masked load and store.
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn predict(
+        q: &mut [f64],
+        vs: &mut [f64],
+        v: &[f64],
+        a: &[f64],
+        dt: f64,
+        h: f64,
+    ) {
+        let p = q.len();
+        let (vs, v, a) = (&mut vs[..p], &v[..p], &a[..p]);
+        let full = p - p % 4;
+        // SAFETY: AVX2 (the caller's guarantee); every load and store touches i..i + 4 ≤ full,
+        // the tail's masked ones full..p, within every slice
+        unsafe {
+            let (dtv, hh, hdt) = (
+                _mm256_set1_pd(dt),
+                _mm256_set1_pd(h),
+                _mm256_set1_pd(h * dt),
+            );
+            let step = |qi: __m256d, vi: __m256d, ai: __m256d| {
+                (
+                    _mm256_add_pd(
+                        qi,
+                        _mm256_add_pd(_mm256_mul_pd(dtv, vi), _mm256_mul_pd(hdt, ai)),
+                    ),
+                    _mm256_add_pd(vi, _mm256_mul_pd(hh, ai)),
+                )
+            };
+            let mut i = 0;
+            while i < full {
+                let (qn, vn) = step(
+                    _mm256_loadu_pd(q.as_ptr().add(i)),
+                    _mm256_loadu_pd(v.as_ptr().add(i)),
+                    _mm256_loadu_pd(a.as_ptr().add(i)),
+                );
+                _mm256_storeu_pd(q.as_mut_ptr().add(i), qn);
+                _mm256_storeu_pd(vs.as_mut_ptr().add(i), vn);
+                i += 4;
+            }
+            if p > full {
+                let m = first(p - full);
+                let (qn, vn) = step(
+                    tail(q.as_ptr().add(full), m),
+                    tail(v.as_ptr().add(full), m),
+                    tail(a.as_ptr().add(full), m),
+                );
+                _mm256_maskstore_pd(q.as_mut_ptr().add(full), m, qn);
+                _mm256_maskstore_pd(vs.as_mut_ptr().add(full), m, vn);
+            }
+        }
+    }
+
+    /// [`super::Portable::free_acceleration`] on AVX2: four modes at a time, the last
+    /// `p mod 4` by masked loads and a masked store.
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn free_acceleration(
+        out: &mut [f64],
+        ai: &[f64],
+        f: &[f64],
+        w2: &[f64],
+        q: &[f64],
+        c: &[f64],
+        vs: &[f64],
+    ) {
+        let p = out.len();
+        let (ai, f, w2, q, c, vs) = (&ai[..p], &f[..p], &w2[..p], &q[..p], &c[..p], &vs[..p]);
+        let full = p - p % 4;
+        // SAFETY: as in `predict`
+        unsafe {
+            let value = |ai: __m256d, f: __m256d, w2: __m256d, q: __m256d, c: __m256d, vs| {
+                _mm256_mul_pd(
+                    ai,
+                    _mm256_sub_pd(_mm256_sub_pd(f, _mm256_mul_pd(w2, q)), _mm256_mul_pd(c, vs)),
+                )
+            };
+            let mut i = 0;
+            while i < full {
+                let x = value(
+                    _mm256_loadu_pd(ai.as_ptr().add(i)),
+                    _mm256_loadu_pd(f.as_ptr().add(i)),
+                    _mm256_loadu_pd(w2.as_ptr().add(i)),
+                    _mm256_loadu_pd(q.as_ptr().add(i)),
+                    _mm256_loadu_pd(c.as_ptr().add(i)),
+                    _mm256_loadu_pd(vs.as_ptr().add(i)),
+                );
+                _mm256_storeu_pd(out.as_mut_ptr().add(i), x);
+                i += 4;
+            }
+            if p > full {
+                let m = first(p - full);
+                let x = value(
+                    tail(ai.as_ptr().add(full), m),
+                    tail(f.as_ptr().add(full), m),
+                    tail(w2.as_ptr().add(full), m),
+                    tail(q.as_ptr().add(full), m),
+                    tail(c.as_ptr().add(full), m),
+                    tail(vs.as_ptr().add(full), m),
+                );
+                _mm256_maskstore_pd(out.as_mut_ptr().add(full), m, x);
+            }
+        }
+    }
+
     /// [`super::Portable::correct_with_energy`] on AVX2.
     ///
     /// # Safety
@@ -513,6 +691,17 @@ mod tests {
                     assert_eq!(o2[r].to_bits(), single.to_bits(), "{n} {rows} {r}");
                 }
             }
+            let (mut q1, mut q2, mut s1, mut s2) =
+                (q.clone(), q.clone(), vec![0.0; n], vec![0.0; n]);
+            Avx2::predict(&mut q1, &mut s1, &vs, &acc, 0.37, 0.185);
+            Portable::predict(&mut q2, &mut s2, &vs, &acc, 0.37, 0.185);
+            let (mut a1, mut a2) = (vec![0.0; n], vec![0.0; n]);
+            Avx2::free_acceleration(&mut a1, &w2, &f, &damping, &q, &b, &c);
+            Portable::free_acceleration(&mut a2, &w2, &f, &damping, &q, &b, &c);
+            let all = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(all(&q1), all(&q2), "{n}");
+            assert_eq!(all(&s1), all(&s2), "{n}");
+            assert_eq!(all(&a1), all(&a2), "{n}");
             let (mut v1, mut v2) = (vec![0.0; n], vec![0.0; n]);
             let e1 = Avx2::correct_with_energy(&mut v1, &vs, &acc, 0.37, &q, &w2, &damping, &f);
             let e2 = Portable::correct_with_energy(&mut v2, &vs, &acc, 0.37, &q, &w2, &damping, &f);

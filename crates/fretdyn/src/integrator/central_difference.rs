@@ -131,32 +131,48 @@ impl CentralDifference {
     /// Steps 1–2: positions at `n+1` and predicted velocity.
     #[inline(always)]
     pub fn predict(&mut self) {
+        self.predict_with::<Portable>()
+    }
+
+    /// [`Self::predict`] with the kernels `K` ([`crate::kernels`]): `q += Δt q̇ + ½Δt² q̈`,
+    /// `q̇* = q̇ + ½Δt q̈`.
+    #[inline(always)]
+    pub(crate) fn predict_with<K: Lanes>(&mut self) {
         let dt = self.dt;
-        let h = 0.5 * dt;
-        let p = self.q.len();
-        let (q, qd_star) = (&mut self.q[..p], &mut self.qd_star[..p]);
-        let (qd, qdd) = (&self.qd[..p], &self.qdd[..p]);
-        for (((q, vs), v), a) in q.iter_mut().zip(qd_star.iter_mut()).zip(qd).zip(qdd) {
-            *q += dt * v + h * dt * a;
-            *vs = v + h * a;
-        }
+        K::predict(
+            &mut self.q,
+            &mut self.qd_star,
+            &self.qd,
+            &self.qdd,
+            dt,
+            0.5 * dt,
+        );
     }
 
     /// Step 5: `q̈_free = A⁻¹ (f − K q − C q̇*)`, written to `self.qdd`.
     #[inline(always)]
     pub fn free_acceleration(&mut self, force: &[f64]) {
+        self.free_acceleration_with::<Portable>(force)
+    }
+
+    /// [`Self::free_acceleration`] with the kernels `K` ([`crate::kernels`]).
+    #[inline(always)]
+    pub(crate) fn free_acceleration_with<K: Lanes>(&mut self, force: &[f64]) {
         match &mut self.operators {
             Operators::Modal {
                 omega2,
                 damping,
                 a_inv,
             } => {
-                let p = self.q.len();
-                let (q, vs, f) = (&self.q[..p], &self.qd_star[..p], &force[..p]);
-                let (w2, c, ai) = (&omega2[..p], &damping[..p], &a_inv[..p]);
-                for (i, a) in self.qdd[..p].iter_mut().enumerate() {
-                    *a = ai[i] * (f[i] - w2[i] * q[i] - c[i] * vs[i]);
-                }
+                K::free_acceleration(
+                    &mut self.qdd,
+                    a_inv,
+                    force,
+                    omega2,
+                    &self.q,
+                    damping,
+                    &self.qd_star,
+                );
             }
             Operators::Dense {
                 damping,

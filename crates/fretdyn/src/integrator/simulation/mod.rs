@@ -659,14 +659,14 @@ impl<'m> Simulation<'m> {
     fn try_step<K: Lanes>(&mut self) -> std::result::Result<(), Divergence> {
         self.step += 1;
         let t = self.step as f64 * self.settings.dt;
-        self.cd.predict();
+        self.cd.predict_with::<K>();
         self.external_force(t);
         if self.fluid.is_some() {
             self.fluid_elastic_force::<K>(self.step, true);
         }
         self.detect::<K>(t, true);
         self.contact_forces();
-        self.cd.free_acceleration(&self.force);
+        self.cd.free_acceleration_with::<K>(&self.force);
         self.lagrange::<K>();
         let modal = self.cd.correct_with::<K>(&self.external);
         self.full_step_velocities::<K>(false);
