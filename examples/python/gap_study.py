@@ -52,17 +52,18 @@ def main():
         from dask.distributed import Client, LocalCluster
 
         with LocalCluster(n_workers=2, threads_per_worker=1) as cluster, Client(cluster) as client:
-            done = fretdyn.sweep(study, table, client=client)
+            t = fretdyn.sweep(study, table, client=client)
     else:
-        done = fretdyn.sweep(study, table)
-    print(f"{done} runs done, table in {table}")
+        t = fretdyn.sweep(study, table)
+    # the table: a pandas DataFrame (a numpy structured array without pandas), by run
+    print(f"{len(t)} runs in {table}")
 
-    t = fretdyn.read_table(table)
-    contacts = [k.split(".")[0] for k in t if k.endswith(".wear_work_rate")]
+    columns = t.columns if hasattr(t, "columns") else t.dtype.names
+    contacts = [k.split(".")[0] for k in columns if k.endswith(".wear_work_rate")]
     # total wear work rate over the supports
-    total = sum(t[f"{c}.wear_work_rate"] for c in contacts)
-    x = t["contacts.*.obstacle.clearance"]
-    method = np.array(t["tangential.method"])
+    total = sum(np.asarray(t[f"{c}.wear_work_rate"]) for c in contacts)
+    x = np.asarray(t["contacts.*.obstacle.clearance"])
+    method = np.asarray(t["tangential.method"])
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for m in METHODS:

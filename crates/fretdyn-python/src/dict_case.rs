@@ -78,8 +78,9 @@ impl Document {
     /// The key path of the dict for a parse error at `line` (1-based) with `message`: the
     /// path the line holds. An error reported at a table (a tagged table such as an obstacle
     /// is read whole) is narrowed to the key: for a missing or unknown field, the table's path
-    /// and the field; for a value of the wrong type, the one value of the table shown as the
-    /// message shows it (`string "big"`), when only one is.
+    /// and the field (the table's path alone when the unknown field is the table itself); for
+    /// a value of the wrong type, the one value of the table shown as the message shows it
+    /// (`string "big"`), when only one is.
     pub fn path_at(&self, line: usize, message: &str) -> Option<String> {
         let held = self.lines.get(line.checked_sub(1)?)?;
         let Some(table) = &held.table else {
@@ -90,7 +91,13 @@ impl Document {
             .find_map(|p| message.strip_prefix(p))
             .and_then(|rest| rest.split('`').next());
         if let Some(f) = field {
-            return Some(join(&held.path, f));
+            // a table the case does not have is reported at its own header
+            let own = held.path.rsplit(['.', ']']).next() == Some(f);
+            return Some(if own && !table.contains_key(f) {
+                held.path.clone()
+            } else {
+                join(&held.path, f)
+            });
         }
         let unexpected = ["invalid type: ", "invalid value: "]
             .iter()

@@ -1,8 +1,9 @@
 //! The native part of the Python package `fretdyn` (module `fretdyn._native`): cases from a
-//! TOML file, TOML text or JSON (Python dicts), runs with the GIL released and Ctrl-C honoured,
-//! results as numpy arrays, the Connors stability check of a case with flow zones, and the
-//! rows of studies for local or Dask execution. The
-//! Python-facing API is `python/fretdyn/__init__.py`.
+//! TOML file, TOML text or JSON (Python dicts), changed by key paths and given back as JSON,
+//! runs with the GIL released and Ctrl-C honoured, results as numpy arrays with their impacts
+//! and blocks, the names, dimensions and units of the results, the Connors stability check of
+//! a case with flow zones, and the rows of studies (from a file or a dict) for local or Dask
+//! execution. The Python-facing API is `python/fretdyn/__init__.py`.
 
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -10,7 +11,7 @@ use std::path::{Path, PathBuf};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 
 mod dict_case;
 use dict_case::Document;
@@ -26,10 +27,22 @@ fn err(e: fretdyn::Error) -> PyErr {
     FretdynError::new_err(e.to_string())
 }
 
-/// A case: model and settings, ready to run.
+/// A case: model and settings, ready to run, and the folder its file names are relative to.
 #[pyclass(module = "fretdyn._native", frozen)]
 struct Case {
     inner: fretdyn::case::Case,
+    base_dir: PathBuf,
+}
+
+/// `dir` made absolute (from the current folder), so that a case reads the same files
+/// whatever folder it is run from later.
+fn absolute(dir: &Path) -> PathBuf {
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf())
 }
 
 #[pymethods]
@@ -69,6 +82,23 @@ impl Case {
             .collect()
     }
 
+    /// Names of the structure points of the contacts, in the order of the contacts.
+    #[getter]
+    fn contact_points(&self) -> Vec<String> {
+        let points = &self.inner.model.basis.points;
+        self.inner
+            .model
+            .contacts
+            .iter()
+            .map(|c| {
+                points
+                    .get(c.point)
+                    .map(|p| p.name.clone())
+                    .unwrap_or_default()
+            })
+            .collect()
+    }
+
     /// Natural frequencies of the basis, Hz.
     #[getter]
     fn frequencies_hz(&self) -> Vec<f64> {
@@ -79,6 +109,24 @@ impl Case {
             .iter()
             .map(|w| w / std::f64::consts::TAU)
             .collect()
+    }
+
+    /// Folder the case's relative file names are resolved from (absolute).
+    #[getter]
+    fn base_dir(&self) -> PathBuf {
+        self.base_dir.clone()
+    }
+
+    /// The case as JSON with the structure of a case file (its TOML as read, or as changed by
+    /// `case_with`), the title included, file names made absolute.
+    fn to_json(&self) -> String {
+        let mut value = self.inner.echo.clone();
+        fretdyn::case::absolute_file_names(&mut value, &self.base_dir);
+        if let (serde_json::Value::Object(map), false) = (&mut value, self.inner.title.is_empty()) {
+            map.entry("title")
+                .or_insert_with(|| serde_json::Value::String(self.inner.title.clone()));
+        }
+        value.to_string()
     }
 
     fn __repr__(&self) -> String {
@@ -97,7 +145,10 @@ impl Case {
 #[pyfunction]
 fn load_case(path: PathBuf) -> PyResult<Case> {
     fretdyn::case::Case::from_file(&path)
-        .map(|inner| Case { inner })
+        .map(|inner| Case {
+            inner,
+            base_dir: absolute(path.parent().unwrap_or(Path::new("."))),
+        })
         .map_err(|e| FretdynError::new_err(e.in_file(&path)))
 }
 
@@ -106,8 +157,51 @@ fn load_case(path: PathBuf) -> PyResult<Case> {
 #[pyo3(signature = (text, base_dir = PathBuf::from(".")))]
 fn case_from_toml(text: &str, base_dir: PathBuf) -> PyResult<Case> {
     fretdyn::case::Case::from_toml_str(text, &base_dir)
-        .map(|inner| Case { inner })
+        .map(|inner| Case {
+            inner,
+            base_dir: absolute(&base_dir),
+        })
         .map_err(err)
+}
+
+/// The JSON object of a case or a study given as a Python dict.
+fn json_object(json: &str, what: &str) -> PyResult<serde_json::Map<String, serde_json::Value>> {
+    let value: serde_json::Value = serde_json::from_str(json)
+        .map_err(|e| FretdynError::new_err(format!("the {what} is not valid JSON: {e}")))?;
+    match value {
+        serde_json::Value::Object(root) => Ok(root),
+        _ => Err(FretdynError::new_err(format!(
+            "a {what} is a dict with the keys of a {what} file"
+        ))),
+    }
+}
+
+/// An error of the parser of the TOML text `doc` was written to, named by the key path of
+/// the dict (the other errors name their field already).
+fn dict_error(doc: &Document, e: fretdyn::Error) -> PyErr {
+    match e {
+        fretdyn::Error::Parse { line, message, .. } => {
+            FretdynError::new_err(match doc.path_at(line, &message) {
+                Some(path) => format!("{path}: {message}"),
+                None => message,
+            })
+        }
+        other => err(other),
+    }
+}
+
+/// The case of a dict with the structure of a case file.
+fn case_from_map(
+    root: &serde_json::Map<String, serde_json::Value>,
+    base_dir: &Path,
+) -> PyResult<Case> {
+    let doc = Document::from_json(root).map_err(FretdynError::new_err)?;
+    fretdyn::case::Case::from_toml_str(&doc.text, base_dir)
+        .map(|inner| Case {
+            inner,
+            base_dir: absolute(base_dir),
+        })
+        .map_err(|e| dict_error(&doc, e))
 }
 
 /// A case from JSON text with the structure of a case file (how Python dicts come in). It is
@@ -116,29 +210,50 @@ fn case_from_toml(text: &str, base_dir: PathBuf) -> PyResult<Case> {
 #[pyfunction]
 #[pyo3(signature = (json, base_dir = PathBuf::from(".")))]
 fn case_from_json(json: &str, base_dir: PathBuf) -> PyResult<Case> {
-    let value: serde_json::Value = serde_json::from_str(json)
-        .map_err(|e| FretdynError::new_err(format!("the case is not valid JSON: {e}")))?;
-    let serde_json::Value::Object(root) = value else {
-        return Err(FretdynError::new_err(
-            "a case is a dict with the keys of a case file (time, structure, contacts, …)",
-        ));
-    };
-    let doc = Document::from_json(&root).map_err(FretdynError::new_err)?;
-    fretdyn::case::Case::from_toml_str(&doc.text, &base_dir)
-        .map(|inner| Case { inner })
-        .map_err(|e| match e {
-            fretdyn::Error::Parse { line, message, .. } => {
-                FretdynError::new_err(match doc.path_at(line, &message) {
-                    Some(path) => format!("{path}: {message}"),
-                    None => message,
-                })
+    case_from_map(&json_object(json, "case")?, &base_dir)
+}
+
+/// A new case: `case` with the values of `changes`, JSON `[[key path, value], …]` applied in
+/// order. A key path is that of a study parameter (`fretdyn::case::key_path`:
+/// `contacts[0].obstacle.clearance`, `contacts.*.friction.mu`); missing keys of tables are
+/// added, then the case's parser checks them. Errors name the key path.
+#[pyfunction]
+fn case_with(case: &Case, changes: &str) -> PyResult<Case> {
+    use fretdyn::case::key_path::{KeyPath, Missing};
+    let changes: Vec<(String, serde_json::Value)> = serde_json::from_str(changes)
+        .map_err(|e| FretdynError::new_err(format!("the changes are not valid JSON: {e}")))?;
+    let mut value: toml::Value = toml::Value::try_from(&case.inner.echo)
+        .map_err(|e| FretdynError::new_err(format!("the case cannot be changed: {e}")))?;
+    for (key, new) in &changes {
+        let new = match new {
+            serde_json::Value::Null => {
+                return Err(FretdynError::new_err(format!(
+                    "{key}: None is not a value of a case (leave the key out)"
+                )));
             }
-            other => err(other),
-        })
+            v => toml::Value::try_from(v)
+                .map_err(|e| FretdynError::new_err(format!("{key}: {e}")))?,
+        };
+        KeyPath::parse(key)
+            .and_then(|path| path.set(&mut value, &new, Missing::Create))
+            .map_err(|e| FretdynError::new_err(e.to_string()))?;
+    }
+    let json = serde_json::to_value(&value)
+        .map_err(|e| FretdynError::new_err(format!("the case cannot be changed: {e}")))?;
+    let serde_json::Value::Object(mut root) = json else {
+        return Err(FretdynError::new_err("a case is a table"));
+    };
+    if !case.inner.title.is_empty() {
+        root.entry("title")
+            .or_insert_with(|| serde_json::Value::String(case.inner.title.clone()));
+    }
+    case_from_map(&root, &case.base_dir)
 }
 
 /// Runs a case with the GIL released; Ctrl-C stops it (KeyboardInterrupt). Returns a dict of
-/// numpy arrays (the keys of `results.npz`) and `summary_json`, the text of `summary.json`.
+/// numpy arrays (the keys of `results.npz`), `summary_json`, the text of `summary.json`, and
+/// `impacts` and `blocks`, the columns of `impacts.csv` and `blocks.csv` (dicts of numpy
+/// arrays, in the files' order; `name` a list of str).
 /// A run whose time histories do not fit in memory twice (the run's, then numpy's copy) is
 /// refused before it starts (FretdynError naming `output.every`), not left to abort the
 /// interpreter.
@@ -218,6 +333,9 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
     )?;
     let summary = fretdyn::results::output::summary(c, &results);
     out.set_item("summary_json", summary.to_string())?;
+    let names: Vec<String> = c.model.contacts.iter().map(|k| k.name.clone()).collect();
+    out.set_item("impacts", impacts(py, &results.impacts, &names)?)?;
+    out.set_item("blocks", blocks(py, &results.blocks, &names)?)?;
     if matches!(
         results.termination,
         fretdyn::integrator::simulation::Termination::Stopped { .. }
@@ -225,6 +343,122 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
         return Err(PyKeyboardInterrupt::new_err("the run was interrupted"));
     }
     Ok(out)
+}
+
+/// The columns of `impacts.csv` (`fretdyn::results::stream`) of `impacts`.
+fn impacts<'py>(
+    py: Python<'py>,
+    impacts: &[fretdyn::results::statistics::Impact],
+    names: &[String],
+) -> PyResult<Bound<'py, PyDict>> {
+    use fretdyn::results::statistics::Impact;
+    let out = PyDict::new(py);
+    let contact: Vec<i64> = impacts.iter().map(|i| i.contact as i64).collect();
+    out.set_item("contact", PyArray1::from_vec(py, contact))?;
+    let name: Vec<&str> = impacts
+        .iter()
+        .map(|i| names.get(i.contact).map_or("", String::as_str))
+        .collect();
+    out.set_item("name", name)?;
+    type Column = fn(&Impact) -> f64;
+    let columns: [(&str, Column); 8] = [
+        ("start", |i| i.start),
+        ("duration", |i| i.duration),
+        ("contact_time", |i| i.contact_time),
+        ("peak_time", |i| i.peak_time),
+        ("peak_force", |i| i.peak_force),
+        ("impulse", |i| i.impulse),
+        ("impact_speed", |i| i.impact_speed),
+        ("rebound_speed", |i| i.rebound_speed),
+    ];
+    for (key, value) in columns {
+        out.set_item(
+            key,
+            PyArray1::from_vec(py, impacts.iter().map(value).collect()),
+        )?;
+    }
+    let rebounds: Vec<i64> = impacts.iter().map(|i| i64::from(i.rebounds)).collect();
+    out.set_item("rebounds", PyArray1::from_vec(py, rebounds))?;
+    out.set_item(
+        "angle_deg",
+        PyArray1::from_vec(py, impacts.iter().map(|i| i.angle_deg).collect()),
+    )?;
+    Ok(out)
+}
+
+/// The columns of `blocks.csv` (`fretdyn::results::stream`) of `blocks`.
+fn blocks<'py>(
+    py: Python<'py>,
+    blocks: &[fretdyn::results::statistics::BlockStatistics],
+    names: &[String],
+) -> PyResult<Bound<'py, PyDict>> {
+    use fretdyn::results::statistics::ContactStatistics;
+    let out = PyDict::new(py);
+    let block: Vec<i64> = blocks.iter().map(|b| b.block as i64).collect();
+    out.set_item("block", PyArray1::from_vec(py, block))?;
+    out.set_item(
+        "t_start",
+        PyArray1::from_vec(py, blocks.iter().map(|b| b.t_start).collect()),
+    )?;
+    out.set_item(
+        "t_end",
+        PyArray1::from_vec(py, blocks.iter().map(|b| b.t_end).collect()),
+    )?;
+    let name: Vec<&str> = blocks
+        .iter()
+        .map(|b| {
+            names
+                .get(b.contact)
+                .map_or(b.statistics.name.as_str(), String::as_str)
+        })
+        .collect();
+    out.set_item("name", name)?;
+    let impacts: Vec<i64> = blocks.iter().map(|b| b.statistics.impacts as i64).collect();
+    out.set_item("impacts", PyArray1::from_vec(py, impacts))?;
+    type Column = fn(&ContactStatistics) -> f64;
+    let columns: [(&str, Column); 11] = [
+        ("impacts_per_second", |s| s.impacts_per_second),
+        ("contact_time_fraction", |s| s.contact_time_fraction),
+        ("stick_time_fraction", |s| s.stick_time_fraction),
+        ("slip_time_fraction", |s| s.slip_time_fraction),
+        ("normal_force_mean", |s| s.normal_force_mean),
+        ("normal_force_rms", |s| s.normal_force_rms),
+        ("normal_force_max", |s| s.normal_force_max),
+        ("tangential_force_rms", |s| s.tangential_force_rms),
+        ("wear_work_rate", |s| s.wear_work_rate),
+        ("normal_wear_work_rate", |s| s.normal_wear_work_rate),
+        ("wear_volume", |s| s.wear_volume),
+    ];
+    for (key, value) in columns {
+        out.set_item(
+            key,
+            PyArray1::from_vec(py, blocks.iter().map(|b| value(&b.statistics)).collect()),
+        )?;
+    }
+    Ok(out)
+}
+
+/// The names, dimensions, units and long names of the time histories of a run
+/// (`fretdyn::results::variables::VARIABLES`, the keys of `results.npz`) and of the
+/// coordinates along their dimensions (`COORDINATES`): two lists of dicts with the keys
+/// `name`, `dims`, `units`, `long_name`, `flag_meanings`.
+#[pyfunction]
+fn variables<'py>(py: Python<'py>) -> PyResult<(Bound<'py, PyList>, Bound<'py, PyList>)> {
+    use fretdyn::results::variables::{COORDINATES, VARIABLES, Variable};
+    let list = |table: &[Variable]| -> PyResult<Bound<'py, PyList>> {
+        let out = PyList::empty(py);
+        for v in table {
+            let d = PyDict::new(py);
+            d.set_item("name", v.name)?;
+            d.set_item("dims", v.dims.to_vec())?;
+            d.set_item("units", v.units)?;
+            d.set_item("long_name", v.long_name)?;
+            d.set_item("flag_meanings", v.flag_meanings.to_vec())?;
+            out.append(d)?;
+        }
+        Ok(out)
+    };
+    Ok((list(&VARIABLES)?, list(&COORDINATES)?))
 }
 
 /// The Connors fluid-elastic stability check of every mode of a case with a `[flow]` section
@@ -268,27 +502,64 @@ fn stability<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> 
     Ok(out)
 }
 
-fn study(path: &Path) -> PyResult<fretdyn::apps::study::Study> {
-    fretdyn::apps::study::Study::from_file(path).map_err(|e| FretdynError::new_err(e.in_file(path)))
+/// Where a study comes from: the path of a study file, or `(json, base_dir)`, a dict with the
+/// structure of a study file as JSON whose `base` is the path of a case file (relative to
+/// `base_dir`) or a case as a dict (its file names relative to `base_dir`). A tuple of str
+/// pickles: Dask sends it to the workers, which build the study again.
+#[derive(FromPyObject)]
+enum StudySource {
+    File(PathBuf),
+    Dict(String, PathBuf),
+}
+
+impl StudySource {
+    /// An error about the study: a file's is prefixed by its name, as the CLI's.
+    fn error(&self, e: fretdyn::Error) -> PyErr {
+        match self {
+            StudySource::File(path) => FretdynError::new_err(e.in_file(path)),
+            StudySource::Dict(..) => err(e),
+        }
+    }
+
+    fn study(&self) -> PyResult<fretdyn::apps::study::Study> {
+        use fretdyn::apps::study::Study;
+        match self {
+            StudySource::File(path) => Study::from_file(path).map_err(|e| self.error(e)),
+            StudySource::Dict(json, base_dir) => {
+                let mut root = json_object(json, "study")?;
+                let base = match root.get("base") {
+                    Some(serde_json::Value::Object(_)) => {
+                        let case = root.remove("base").unwrap_or_default();
+                        let value = toml::Value::try_from(&case)
+                            .map_err(|e| FretdynError::new_err(format!("base: {e}")))?;
+                        Some((value, absolute(base_dir)))
+                    }
+                    _ => None,
+                };
+                let doc = Document::from_json(&root).map_err(FretdynError::new_err)?;
+                Study::from_toml_str(&doc.text, base_dir, base).map_err(|e| dict_error(&doc, e))
+            }
+        }
+    }
 }
 
 /// Number of runs of a study.
 #[pyfunction]
-fn study_runs(path: PathBuf) -> PyResult<usize> {
-    Ok(study(&path)?.runs().len())
+fn study_runs(study: StudySource) -> PyResult<usize> {
+    Ok(study.study()?.runs().len())
 }
 
 /// Header line of a study's table.
 #[pyfunction]
-fn study_header(path: PathBuf) -> PyResult<String> {
-    let s = study(&path)?;
+fn study_header(study: StudySource) -> PyResult<String> {
+    let s = study.study()?;
     Ok(s.header(&s.contact_names()))
 }
 
 /// Runs run `index` of a study (GIL released) and returns its table row.
 #[pyfunction]
-fn study_row(py: Python<'_>, path: PathBuf, index: usize) -> PyResult<String> {
-    let s = study(&path)?;
+fn study_row(py: Python<'_>, study: StudySource, index: usize) -> PyResult<String> {
+    let s = study.study()?;
     let runs = s.runs();
     let run = runs
         .get(index)
@@ -299,9 +570,9 @@ fn study_row(py: Python<'_>, path: PathBuf, index: usize) -> PyResult<String> {
 /// Runs a study on this machine, `jobs` runs at a time (0: one per core), into the table
 /// `table` (finished runs already in it are skipped); returns the number of runs done.
 #[pyfunction]
-#[pyo3(signature = (path, table, jobs = 0))]
-fn study_local(py: Python<'_>, path: PathBuf, table: PathBuf, jobs: usize) -> PyResult<usize> {
-    let s = study(&path)?;
+#[pyo3(signature = (study, table, jobs = 0))]
+fn study_local(py: Python<'_>, study: StudySource, table: PathBuf, jobs: usize) -> PyResult<usize> {
+    let s = study.study()?;
     py.detach(|| s.execute(&table, jobs, &|_, _| {}))
         .map_err(err)
 }
@@ -310,17 +581,17 @@ fn study_local(py: Python<'_>, path: PathBuf, table: PathBuf, jobs: usize) -> Py
 /// from its table, as the JSON of `percentiles.json`; written into `output` (a folder) too
 /// when given. `None` when the study asks for no percentiles.
 #[pyfunction]
-#[pyo3(signature = (path, table, output = None))]
+#[pyo3(signature = (study, table, output = None))]
 fn study_percentiles(
     py: Python<'_>,
-    path: PathBuf,
+    study: StudySource,
     table: PathBuf,
     output: Option<PathBuf>,
 ) -> PyResult<Option<String>> {
-    let s = study(&path)?;
+    let s = study.study()?;
     let report = py
         .detach(|| s.percentiles(&table))
-        .map_err(|e| FretdynError::new_err(e.in_file(&path)))?;
+        .map_err(|e| study.error(e))?;
     if let (Some(r), Some(dir)) = (&report, &output) {
         r.write(dir).map_err(err)?;
     }
@@ -334,6 +605,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load_case, m)?)?;
     m.add_function(wrap_pyfunction!(case_from_toml, m)?)?;
     m.add_function(wrap_pyfunction!(case_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(case_with, m)?)?;
+    m.add_function(wrap_pyfunction!(variables, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(study_runs, m)?)?;

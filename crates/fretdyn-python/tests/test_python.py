@@ -192,6 +192,11 @@ def study(tmp_path):
     return path
 
 
+def done(table):
+    """The runs a sweep did, from the DataFrame it returned."""
+    return table.attrs["runs_done"]
+
+
 def rows(table):
     lines = Path(table).read_text().splitlines()
     body = sorted(lines[1:], key=lambda l: int(l.split(",")[0]))
@@ -202,13 +207,14 @@ def rows(table):
 def test_a_sweep_on_a_dask_cluster_equals_the_local_sweep(tmp_path):
     distributed = pytest.importorskip("dask.distributed")
     path = study(tmp_path)
-    assert fretdyn.sweep(path, tmp_path / "local.csv", jobs=2) == 8
+    assert done(fretdyn.sweep(path, tmp_path / "local.csv", jobs=2)) == 8
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
-        assert fretdyn.sweep(path, tmp_path / "dask.csv", client=client) == 8
-        # run again: nothing left to do
-        assert fretdyn.sweep(path, tmp_path / "dask.csv", client=client) == 0
+        assert done(fretdyn.sweep(path, tmp_path / "dask.csv", client=client)) == 8
+        # run again: nothing left to do, the whole table back
+        again = fretdyn.sweep(path, tmp_path / "dask.csv", client=client)
+        assert done(again) == 0 and len(again) == 8
     local, dask = rows(tmp_path / "local.csv"), rows(tmp_path / "dask.csv")
     assert local == dask
     assert len(local[1]) == 8
@@ -370,11 +376,11 @@ def test_a_probabilistic_study_on_a_dask_cluster_equals_the_local_study(tmp_path
     and the percentiles are the same on 2 Dask workers as on this machine's cores."""
     distributed = pytest.importorskip("dask.distributed")
     path = probabilistic_study(tmp_path)
-    assert fretdyn.sweep(path, tmp_path / "local.csv", jobs=2) == 6
+    assert done(fretdyn.sweep(path, tmp_path / "local.csv", jobs=2)) == 6
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
-        assert fretdyn.sweep(path, tmp_path / "dask.csv", client=client) == 6
+        assert done(fretdyn.sweep(path, tmp_path / "dask.csv", client=client)) == 6
     local, dask = rows_by_name(tmp_path / "local.csv"), rows_by_name(tmp_path / "dask.csv")
     assert local == dask
     header = local[0]
@@ -407,11 +413,11 @@ def test_a_probabilistic_service_life_study_on_dask_equals_the_local_study(tmp_p
         '[[parameters]]\nkey = "statistics.t_start"\nvalues = [0.01]\n\n'
         '[percentiles]\nstatistics = ["depth_at_target"]\nlevels = [50, 95]\n'
     )
-    assert fretdyn.sweep(path, tmp_path / "local.csv", jobs=2) == 4
+    assert done(fretdyn.sweep(path, tmp_path / "local.csv", jobs=2)) == 4
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
-        assert fretdyn.sweep(path, tmp_path / "dask.csv", client=client) == 4
+        assert done(fretdyn.sweep(path, tmp_path / "dask.csv", client=client)) == 4
     local, dask = rows_by_name(tmp_path / "local.csv"), rows_by_name(tmp_path / "dask.csv")
     assert local == dask
     t = fretdyn.read_table(tmp_path / "dask.csv")

@@ -3,16 +3,21 @@ Coulomb friction (explicit central differences; penalty, Active Set or projected
 
     import fretdyn
     case = fretdyn.Case.from_file("examples/v1a_oblique_impact.toml")
-    r = fretdyn.run(case)            # numpy arrays, GIL released, Ctrl-C honoured
+    r = fretdyn.run(case)            # a Result: numpy arrays, GIL released, Ctrl-C honoured
     r = fretdyn.run("examples/v1a_oblique_impact.toml")   # the same, from the path
-    r["contact_normal_force"][:, 0], r["summary"]["contacts"][0]["wear_work_rate"]
-    r["summary"]["energy_balance"]["fluid_work"]   # the energy the flow fed in, J
+    r.contact_normal_force[:, 0], r.summary["contacts"][0]["wear_work_rate"]
+    r.impacts, r.blocks, r.contacts  # tables (pandas DataFrames when pandas is installed)
+    r.to_xarray()                    # an xarray.Dataset with names, dimensions and units
+    fretdyn.plot.orbits(r)           # matplotlib plots for notebooks
+    wider = case.with_(**{"contacts[0].obstacle.gap": 1e-4})   # a changed copy
     s = fretdyn.stability("examples/ubend_flow.toml")   # the Connors check, per mode
-    s["ratio"], s["effective_velocity"], s["reference_zone"]
+    table = fretdyn.sweep({"base": case, "parameters": [
+        {"key": "contacts[0].friction.mu", "values": [0.1, 0.3]}]})   # a DataFrame
 
 Cases come from a TOML file, TOML text, or a Python dict with the structure of a case file
 (numpy arrays are accepted anywhere a list is). Studies (`sweep`) run on every core, or on a
-Dask cluster when given a `dask.distributed.Client`.
+Dask cluster when given a `dask.distributed.Client`. pandas, xarray and matplotlib are
+optional (`pip install fretdyn[all]`). docs/PYTHON_API.md lists the API.
 """
 
 from __future__ import annotations
@@ -20,8 +25,10 @@ from __future__ import annotations
 import csv
 import json
 import os
+import tempfile
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -30,8 +37,8 @@ from ._native import FretdynError
 from . import med  # modal bases from Code_Aster's MED files (docs/MED.md)
 
 __all__ = [
-    "Case", "FretdynError", "run", "stability", "sweep", "percentiles", "read_table",
-    "modal_structure", "__version__",
+    "Case", "Result", "FretdynError", "run", "stability", "sweep", "percentiles",
+    "read_table", "modal_structure", "variables", "plot", "__version__",
 ]
 __version__ = _native.__version__
 
@@ -44,6 +51,8 @@ def _plain(value: Any) -> Any:
         return value.tolist()
     if isinstance(value, np.generic):
         return value.item()
+    if isinstance(value, Case):
+        return value.to_dict()
     if isinstance(value, Mapping):
         return {str(k): _plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -51,36 +60,250 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _pandas():
+    """pandas, or None when it is not installed."""
+    try:
+        import pandas
+    except ImportError:
+        return None
+    return pandas
+
+
+def _table(columns: Mapping[str, Any]):
+    """Columns (name → sequence, all of one length) as a pandas DataFrame when pandas is
+    installed, else as a numpy structured array with the same field names."""
+    arrays = {k: np.asarray(v) for k, v in columns.items()}
+    pd = _pandas()
+    if pd is not None:
+        return pd.DataFrame(arrays, columns=list(arrays))
+    n = len(next(iter(arrays.values()))) if arrays else 0
+    out = np.empty(n, dtype=[(k, a.dtype) for k, a in arrays.items()])
+    for k, a in arrays.items():
+        out[k] = a
+    return out
+
+
+def variables() -> Tuple[List[dict], List[dict]]:
+    """The names, dimensions, units and long names of a run's time histories and of the
+    coordinates along their dimensions.
+
+    One table in the Rust library (``fretdyn::results::variables``) holds them; the names are
+    the keys of ``results.npz`` and of `Result`, and `Result.to_xarray` and `fretdyn.plot`
+    take their units and labels from it.
+
+    Returns
+    -------
+    variables : list of dict
+        One dict per time history (``t``, ``q``, ``qdot``, ``contact_normal_force``, …) with
+        the keys ``name``, ``dims`` (list of dimension names among ``time``, ``contact``,
+        ``mode``, ``direction``), ``units`` (UDUNITS), ``long_name`` and ``flag_meanings``
+        (the meanings of a code's values 0, 1, 2, …; empty otherwise).
+    coordinates : list of dict
+        The same keys for the coordinates: ``time``, ``contact`` (names), ``point`` (the
+        structure point of each contact), ``mode`` (from 1), ``frequency`` (Hz),
+        ``direction``.
+
+    Examples
+    --------
+    >>> names, coords = fretdyn.variables()
+    >>> {v["name"]: v["units"] for v in names}["contact_normal_force"]
+    'N'
+    """
+    return _native.variables()
+
+
+def _units() -> dict:
+    """name → the dict of `variables` for every variable and coordinate."""
+    names, coords = _native.variables()
+    return {v["name"]: v for v in [*names, *coords]}
+
+
 class Case:
-    """A case: model and settings, ready to run. Build it with a class method."""
+    """A case: model and settings, ready to run.
+
+    Build it with a class method (`from_file`, `from_toml`, `from_dict`); `with_` gives a
+    changed copy, `to_dict` the case as a dict. A Case is immutable.
+
+    Examples
+    --------
+    >>> case = fretdyn.Case.from_file("examples/v1a_oblique_impact.toml")
+    >>> case.dt, case.steps, case.contact_names
+    (1e-06, 4000, ['plane'])
+    """
 
     def __init__(self, native: "_native.Case"):
         self._native = native
 
     @classmethod
     def from_file(cls, path: PathLike) -> "Case":
-        """Reads a case file (TOML); relative file names are resolved from its folder."""
+        """Reads a case file.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            A case file (TOML); its relative file names are resolved from its folder.
+
+        Returns
+        -------
+        Case
+
+        Raises
+        ------
+        FretdynError
+            The file cannot be read or is not a valid case; the message names the file, the
+            field and the fix, as the CLI's.
+
+        Examples
+        --------
+        >>> case = fretdyn.Case.from_file("examples/tube_multispan.toml")
+        """
         return cls(_native.load_case(os.fspath(path)))
 
     @classmethod
     def from_toml(cls, text: str, base_dir: PathLike = ".") -> "Case":
-        """A case from TOML text."""
+        """A case from the text of a case file.
+
+        Parameters
+        ----------
+        text : str
+            TOML text with the keys of a case file.
+        base_dir : str or os.PathLike, default "."
+            Folder its relative file names are resolved from.
+
+        Returns
+        -------
+        Case
+
+        Examples
+        --------
+        >>> text = open("examples/v1a_oblique_impact.toml").read()
+        >>> case = fretdyn.Case.from_toml(text.replace("mu = 0.3", "mu = 0.5"))
+        """
         return cls(_native.case_from_toml(text, os.fspath(base_dir)))
 
     @classmethod
     def from_dict(cls, case: Mapping[str, Any], base_dir: PathLike = ".") -> "Case":
-        """A case from a dict with the keys of a case file (numpy arrays allowed). Errors name
-        the key path in the dict (`time.dt`, `contacts[0].normal.stiffness`)."""
+        """A case from a dict with the keys of a case file.
+
+        Parameters
+        ----------
+        case : Mapping
+            The tables of a case file as dicts, arrays of tables as lists of dicts; numpy
+            arrays and numbers are accepted anywhere a list or a number is.
+        base_dir : str or os.PathLike, default "."
+            Folder its relative file names are resolved from.
+
+        Returns
+        -------
+        Case
+
+        Raises
+        ------
+        FretdynError
+            The message starts with the key path in the dict (``time.dt``,
+            ``contacts[0].normal.stiffness``).
+
+        Examples
+        --------
+        >>> case = fretdyn.Case.from_dict(other.to_dict())
+        """
         return cls(_native.case_from_json(json.dumps(_plain(case)), os.fspath(base_dir)))
 
-    title = property(lambda self: self._native.title, doc="Title of the case.")
-    dt = property(lambda self: self._native.dt, doc="Time step, s.")
-    steps = property(lambda self: self._native.steps, doc="Number of steps.")
-    modes = property(lambda self: self._native.modes, doc="Number of modes.")
-    contact_names = property(lambda self: self._native.contact_names, doc="Contact names.")
-    frequencies_hz = property(
-        lambda self: np.array(self._native.frequencies_hz), doc="Natural frequencies, Hz."
-    )
+    def with_(self, changes: Optional[Mapping[str, Any]] = None, /, **values: Any) -> "Case":
+        """A copy of the case with some values changed, by the key paths of studies.
+
+        A key path is dotted keys with indices: ``time.dt``, ``contacts[0].friction.mu``
+        (or ``contacts.0.friction.mu``), ``contacts.*.obstacle.clearance`` (``*``: every
+        element). Keys missing from a table are added (``output.every``), then the case is
+        read again as a whole: a key the case format does not have, or a value it does not
+        take, is an error naming the key path.
+
+        Parameters
+        ----------
+        changes : Mapping, optional
+            Key path → value, applied in order (use it for paths that are not Python
+            names: ``{"contacts[0].obstacle.clearance": 2e-4}``).
+        **values
+            More key paths and values, applied after `changes`.
+
+        Returns
+        -------
+        Case
+            A new case; this one is unchanged.
+
+        Raises
+        ------
+        FretdynError
+            The message starts with the key path: ``contacts[2]: no such element; contacts
+            has 1 element (index 0)``.
+
+        Examples
+        --------
+        >>> tight = case.with_({"contacts.*.obstacle.clearance": 5e-5})
+        >>> fine = case.with_(**{"time.dt": 5e-7, "contacts[0].friction.mu": 0.2})
+        """
+        items = [*(changes or {}).items(), *values.items()]
+        pairs = [[str(k), _plain(v)] for k, v in items]
+        return Case(_native.case_with(self._native, json.dumps(pairs)))
+
+    def to_dict(self) -> dict:
+        """The case as a dict with the structure of a case file.
+
+        It is the TOML the case was read from (with the changes of `with_`) and its title;
+        file names are absolute, so that ``Case.from_dict(case.to_dict())`` is the same case
+        from any folder.
+
+        Returns
+        -------
+        dict
+
+        Examples
+        --------
+        >>> d = case.to_dict()
+        >>> d["time"]["dt"]
+        1e-06
+        """
+        return json.loads(self._native.to_json())
+
+    @property
+    def title(self) -> str:
+        """Title of the case (its file's name when it gives none)."""
+        return self._native.title
+
+    @property
+    def dt(self) -> float:
+        """Time step, s."""
+        return self._native.dt
+
+    @property
+    def steps(self) -> int:
+        """Number of steps."""
+        return self._native.steps
+
+    @property
+    def modes(self) -> int:
+        """Number of modes of the basis."""
+        return self._native.modes
+
+    @property
+    def contact_names(self) -> List[str]:
+        """Names of the contacts, in the order of the results' contact axis."""
+        return self._native.contact_names
+
+    @property
+    def contact_points(self) -> List[str]:
+        """Names of the structure points of the contacts, in the order of the contacts."""
+        return self._native.contact_points
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        """Natural frequencies of the basis, Hz, shape (modes,)."""
+        return np.array(self._native.frequencies_hz)
+
+    @property
+    def base_dir(self) -> Path:
+        """Folder the case's relative file names are resolved from."""
+        return Path(self._native.base_dir)
 
     def __repr__(self) -> str:
         return repr(self._native)
@@ -92,8 +315,34 @@ def modal_structure(
     damping_ratio: Optional[Sequence[float]] = None,
     coords: Optional[Mapping[str, Sequence[float]]] = None,
 ) -> dict:
-    """The `[structure]` of a case from numpy arrays: frequencies (p,), damping ratios (p,),
-    and for each point name its mass-normalised rows, shape (3, p) (x, y, z translations)."""
+    """The ``[structure]`` of a case from numpy arrays.
+
+    Parameters
+    ----------
+    frequencies_hz : array_like, shape (p,)
+        Natural frequencies, Hz.
+    points : Mapping
+        Point name → its mass-normalised mode-shape rows, shape (3, p) (x, y, z
+        translations).
+    damping_ratio : array_like, shape (p,), optional
+        Modal damping ratios (default 0).
+    coords : Mapping, optional
+        Point name → its reference position (3,), m.
+
+    Returns
+    -------
+    dict
+        A ``type = "modal"`` structure for `Case.from_dict`.
+
+    Raises
+    ------
+    FretdynError
+        Rows of the wrong shape.
+
+    Examples
+    --------
+    >>> structure = fretdyn.modal_structure([0.0] * 3, {"mass": np.eye(3)})
+    """
     p = len(frequencies_hz)
     structure: dict = {
         "type": "modal",
@@ -132,28 +381,335 @@ def _case(case: Union[Case, PathLike], function: str) -> Case:
     return case
 
 
-def run(case: Union[Case, PathLike]) -> dict:
-    """Runs a case, or the case file at a path (str or os.PathLike), like `fretdyn run` (the
-    GIL is released; Ctrl-C raises KeyboardInterrupt). Returns the arrays of `results.npz` as
-    numpy arrays and `summary`, the content of `summary.json` as a dict (its
-    `energy_balance` includes `fluid_work`, the work of the fluid-elastic forces, J). A
-    diverged run returns what it computed; its `summary["termination"]` says where."""
-    case = _case(case, "run")
-    out = _native.run(case._native)
-    out["summary"] = json.loads(out.pop("summary_json"))
+_ARRAYS = [
+    "t", "q", "qdot", "contact_normal_force", "contact_tangential_force",
+    "contact_slip_velocity", "contact_penetration", "contact_status", "contact_position",
+]
+
+
+def _flatten(entry: Mapping[str, Any], prefix: str = "") -> dict:
+    """The numbers and strings of a (nested) dict, nested keys joined by dots; lists (the
+    peak force histogram) are left out."""
+    out: dict = {}
+    for k, v in entry.items():
+        if isinstance(v, Mapping):
+            out.update(_flatten(v, f"{prefix}{k}."))
+        elif not isinstance(v, (list, tuple)):
+            out[f"{prefix}{k}"] = v
     return out
 
 
+class Result(Mapping):
+    """What `run` returns: the time histories, the summary, the tables of a run.
+
+    The arrays are the keys of ``results.npz`` (attributes, or items for code written for
+    the dict `run` returned before: ``r["contact_normal_force"]``, ``r["summary"]``); their
+    dimensions and units are given by `variables` and kept by `to_xarray`.
+
+    Examples
+    --------
+    >>> r = fretdyn.run("examples/v1a_oblique_impact.toml")
+    >>> r.t.shape, r.contact_normal_force.shape
+    ((4001,), (4001, 1))
+    >>> r.summary["contacts"][0]["wear_work_rate"] == r.contacts["wear_work_rate"][0]
+    True
+    """
+
+    def __init__(self, native: dict, case: Case):
+        self._arrays = {k: native[k] for k in _ARRAYS}
+        self._summary = json.loads(native["summary_json"])
+        self._impacts = native["impacts"]
+        self._blocks = native["blocks"]
+        self._case = case
+
+    # the mapping of the dict `run` returned before: the arrays and "summary"
+    def __getitem__(self, key: str) -> Any:
+        if key == "summary":
+            return self._summary
+        return self._arrays[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter([*self._arrays, "summary"])
+
+    def __len__(self) -> int:
+        return len(self._arrays) + 1
+
+    # a Mapping compares its items, which numpy arrays cannot do as one bool: identity instead
+    __eq__ = object.__eq__
+    __hash__ = object.__hash__
+
+    def __repr__(self) -> str:
+        status = self._summary["termination"]["status"]
+        return (
+            f"Result({self._case.title!r}, {len(self.t)} samples, "
+            f"{len(self.contact_names)} contacts, {status})"
+        )
+
+    @property
+    def t(self) -> np.ndarray:
+        """Time of the samples, s, shape (N,)."""
+        return self._arrays["t"]
+
+    @property
+    def q(self) -> np.ndarray:
+        """Modal displacements (mass-normalised modes), kg^0.5 m, shape (N, modes)."""
+        return self._arrays["q"]
+
+    @property
+    def qdot(self) -> np.ndarray:
+        """Modal velocities (full step), kg^0.5 m/s, shape (N, modes)."""
+        return self._arrays["qdot"]
+
+    @property
+    def contact_normal_force(self) -> np.ndarray:
+        """Normal contact force R_N ≥ 0, N, shape (N, contacts)."""
+        return self._arrays["contact_normal_force"]
+
+    @property
+    def contact_tangential_force(self) -> np.ndarray:
+        """Tangential force of the obstacle on the structure in the contact's tangent basis
+        (t1, t2), N, shape (N, contacts, 2)."""
+        return self._arrays["contact_tangential_force"]
+
+    @property
+    def contact_slip_velocity(self) -> np.ndarray:
+        """Tangential velocity relative to the obstacle (full step), tangent basis, m/s,
+        shape (N, contacts, 2)."""
+        return self._arrays["contact_slip_velocity"]
+
+    @property
+    def contact_penetration(self) -> np.ndarray:
+        """Penetration δ, m (negative: remaining clearance), shape (N, contacts)."""
+        return self._arrays["contact_penetration"]
+
+    @property
+    def contact_status(self) -> np.ndarray:
+        """Contact status, int8: 0 open, 1 stick, 2 slip, shape (N, contacts)."""
+        return self._arrays["contact_status"]
+
+    @property
+    def contact_position(self) -> np.ndarray:
+        """The point relative to the obstacle, m, shape (N, contacts, 2): in a hole, its
+        offset from the hole's centre in the hole's axes (the orbit); for a plane or bars,
+        the distance from the plane and the position along t1."""
+        return self._arrays["contact_position"]
+
+    @property
+    def summary(self) -> dict:
+        """The content of ``summary.json``: per-contact statistics, energy balance, solver
+        counters, the case as read."""
+        return self._summary
+
+    @property
+    def case(self) -> Case:
+        """The case that was run."""
+        return self._case
+
+    @property
+    def contact_names(self) -> List[str]:
+        """Names of the contacts, in the order of the contact axis of the arrays."""
+        return [c["name"] for c in self._summary["contacts"]]
+
+    @property
+    def impacts(self):
+        """One row per impact, the columns of ``impacts.csv``.
+
+        ``contact`` (index), ``name``, ``start``, ``duration``, ``contact_time``,
+        ``peak_time`` (s), ``peak_force`` (N), ``impulse`` (N s), ``impact_speed``,
+        ``rebound_speed`` (m/s), ``rebounds``, ``angle_deg``: a pandas DataFrame when pandas
+        is installed, else a numpy structured array with these fields.
+        """
+        return _table(self._impacts)
+
+    @property
+    def blocks(self):
+        """The statistics of each block (batch) of the statistics window, the columns of
+        ``blocks.csv`` (``block``, ``t_start``, ``t_end``, ``name``, ``impacts``, …): a
+        pandas DataFrame when pandas is installed, else a numpy structured array."""
+        return _table(self._blocks)
+
+    @property
+    def contacts(self):
+        """The per-contact statistics of the summary, one row per contact.
+
+        The columns are the keys of ``summary["contacts"]`` (``name`` first; nested keys
+        joined by dots; the peak force histogram left out), as in ``contacts.csv``: a pandas
+        DataFrame when pandas is installed, else a numpy structured array.
+        """
+        rows = [_flatten(c) for c in self._summary["contacts"]]
+        keys: List[str] = ["name"]
+        for r in rows:
+            keys += [k for k in r if k not in keys]
+        columns = {}
+        for k in keys:
+            values = [r.get(k, np.nan) for r in rows]
+            if all(isinstance(v, str) for v in values):
+                columns[k] = np.array(values, dtype=str)
+            else:
+                columns[k] = np.array([np.nan if v is None else v for v in values])
+        return _table(columns)
+
+    def to_xarray(self):
+        """The time histories as an xarray Dataset with names and units.
+
+        Dimensions ``time``, ``contact``, ``mode``, ``direction``; coordinates ``time`` (s),
+        ``contact`` (names), ``point`` (the structure point of each contact), ``mode`` (from
+        1), ``frequency`` (Hz), ``direction`` (1, 2); every variable and coordinate has
+        ``units`` and ``long_name`` attributes (`variables`); ``contact_status`` has CF
+        ``flag_values`` and ``flag_meanings``. The Dataset's attributes are ``title``,
+        ``fretdyn_version`` and ``summary`` (the summary as JSON text, the case included), so
+        that ``to_netcdf`` writes it.
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Raises
+        ------
+        ImportError
+            xarray is not installed (``pip install xarray``).
+
+        Examples
+        --------
+        >>> ds = r.to_xarray()
+        >>> ds.contact_normal_force.sel(contact="plane").max().item()
+        >>> ds.contact_normal_force.attrs["units"]
+        'N'
+        """
+        try:
+            import xarray as xr
+        except ImportError as e:
+            raise ImportError(
+                "Result.to_xarray needs xarray: pip install xarray (or fretdyn[xarray])"
+            ) from e
+        names, coords_table = _native.variables()
+        attrs = {v["name"]: {"units": v["units"], "long_name": v["long_name"]}
+                 for v in [*names, *coords_table]}
+        for a in attrs.values():
+            if not a["units"]:
+                del a["units"]
+        values = {
+            "time": self.t,
+            "contact": np.array(self.contact_names, dtype=str),
+            "point": np.array(self._case.contact_points, dtype=str),
+            "mode": np.arange(1, self.q.shape[1] + 1),
+            "frequency": self._case.frequencies_hz,
+            "direction": np.array([1, 2]),
+        }
+        coords = {
+            v["name"]: (v["dims"], values[v["name"]], attrs[v["name"]]) for v in coords_table
+        }
+        data = {}
+        for v in names:
+            if v["name"] == "t":
+                continue
+            a = dict(attrs[v["name"]])
+            if v["flag_meanings"]:
+                a["flag_values"] = np.arange(len(v["flag_meanings"]), dtype=np.int8)
+                a["flag_meanings"] = " ".join(v["flag_meanings"])
+            data[v["name"]] = (v["dims"], self._arrays[v["name"]], a)
+        return xr.Dataset(
+            data,
+            coords=coords,
+            attrs={
+                "title": self._summary.get("title", ""),
+                "fretdyn_version": self._summary.get("fretdyn_version", __version__),
+                "summary": json.dumps(self._summary),
+            },
+        )
+
+
+def run(case: Union[Case, PathLike]) -> Result:
+    """Runs a case, like ``fretdyn run``.
+
+    The GIL is released during the run; Ctrl-C raises KeyboardInterrupt. Every sample is kept
+    in memory: a run whose time histories would not fit is refused with their size (raise
+    ``[output] every``, or use ``fretdyn run``, which streams them to disk).
+
+    Parameters
+    ----------
+    case : Case, str or os.PathLike
+        A case, or the path of a case file.
+
+    Returns
+    -------
+    Result
+        The arrays of ``results.npz``, the summary (``summary.json``; its
+        ``energy_balance`` includes ``fluid_work``, the work of the fluid-elastic forces, J),
+        the impacts, blocks and per-contact tables. A diverged run returns what it computed;
+        its ``summary["termination"]`` says where.
+
+    Raises
+    ------
+    FretdynError
+        The case cannot run (Δt above the stable limit, too large for the memory, …).
+    TypeError
+        `case` is neither a Case nor a path.
+
+    Examples
+    --------
+    >>> r = fretdyn.run("examples/v1a_oblique_impact.toml")
+    >>> r.summary["termination"]["status"]
+    'completed'
+    >>> r.impacts["peak_force"].max() == r.contact_normal_force.max()
+    """
+    case = _case(case, "run")
+    return Result(_native.run(case._native), case)
+
+
 def stability(case: Union[Case, PathLike]) -> dict:
-    """The Connors fluid-elastic stability check of every mode of a case with a `[flow]`
-    section, or of the case file at a path, like `fretdyn stability` (docs/FLOW.md). Returns
-    one numpy array per column of `stability.csv` — `mode`, `frequency_hz` (Hz),
-    `damping_ratio`, `reference_density` (kg/m³), `effective_velocity` and
-    `critical_velocity` (m/s), `ratio` (U_eff/U_c; NaN where undefined, inf for an undamped
-    mode in a flow) — `reference_zone` (list of str), and the scalars `connors_constant`,
-    `diameter` (m) and `mass_per_length` (kg/m). A case without `[flow]` raises
-    FretdynError."""
+    """The Connors fluid-elastic stability check of every mode, like ``fretdyn stability``.
+
+    Parameters
+    ----------
+    case : Case, str or os.PathLike
+        A case with a ``[flow]`` section (docs/FLOW.md), or the path of its file.
+
+    Returns
+    -------
+    dict
+        One numpy array per column of ``stability.csv`` — ``mode``, ``frequency_hz`` (Hz),
+        ``damping_ratio``, ``reference_density`` (kg/m³), ``effective_velocity`` and
+        ``critical_velocity`` (m/s), ``ratio`` (U_eff/U_c; NaN where undefined, inf for an
+        undamped mode in a flow) — ``reference_zone`` (list of str), and the scalars
+        ``connors_constant``, ``diameter`` (m) and ``mass_per_length`` (kg/m).
+
+    Raises
+    ------
+    FretdynError
+        The case has no ``[flow]``.
+
+    Examples
+    --------
+    >>> s = fretdyn.stability("examples/ubend_flow.toml")
+    >>> s["ratio"] > 1.0
+    """
     return _native.stability(_case(case, "stability")._native)
+
+
+def _study_source(study: Union[PathLike, Mapping[str, Any]], base_dir: Optional[PathLike]):
+    """What `_native` takes for a study: the absolute path of a study file, or for a dict,
+    ``(JSON, base_dir)`` with its ``base`` as a path (relative to `base_dir`) or a case dict
+    (checked here first, so that its errors name ``base.<key path>``)."""
+    if not isinstance(study, Mapping):
+        if base_dir is not None:
+            raise TypeError("base_dir is for a study given as a dict; a study file's base "
+                            "is relative to the file")
+        return os.fspath(os.path.abspath(study))
+    folder = os.path.abspath(base_dir if base_dir is not None else ".")
+    study = dict(study)
+    base = study.get("base")
+    if isinstance(base, Case):
+        folder = os.fspath(base.base_dir)
+        study["base"] = base.to_dict()
+    elif isinstance(base, Mapping):
+        try:
+            Case.from_dict(base, folder)
+        except FretdynError as e:
+            raise FretdynError(f"base.{e}") from None
+    elif isinstance(base, os.PathLike):
+        study["base"] = os.fspath(base)
+    return (json.dumps(_plain(study)), folder)
 
 
 def _read_done(table: Path, header: str) -> set:
@@ -168,59 +724,172 @@ def _read_done(table: Path, header: str) -> set:
     return {int(l.split(",")[0]) for l in complete if len(l.split(",")) == n}
 
 
-def _row(study: str, index: int) -> str:
+def _row(study: Any, index: int) -> str:
     return _native.study_row(study, index)
 
 
-def sweep(study: PathLike, table: PathLike, client: Any = None, jobs: int = 0) -> int:
-    """Runs a study file (see `fretdyn sweep`) into the CSV `table`, one row per finished run,
-    skipping the runs already in it. Without `client`, on this machine, `jobs` runs at a time
-    (0: one per core). With a `dask.distributed.Client`, each run is a task on the cluster
-    (the workers need this package and the study's files) and rows are written as tasks
-    finish. Parameters drawn from distributions (`samples = N`, docs/STUDIES.md) take the
-    same values on the cluster as here (each draw is a function of the study seed, the sample
-    and the parameter); `percentiles(study, table)` then gives P50/P95/P99 with their errors.
-    Returns the number of runs done."""
-    study = os.fspath(os.path.abspath(study))
+def _frame(table: Path):
+    """A study table sorted by run: a DataFrame with pandas, else a structured array."""
+    columns = read_table(table)
+    order = np.argsort(columns["run"], kind="stable") if "run" in columns else None
+    out = {}
+    for k, v in columns.items():
+        a = np.asarray(v) if isinstance(v, np.ndarray) else np.array(v, dtype=str)
+        out[k] = a if order is None else a[order]
+    return _table(out)
+
+
+def sweep(
+    study: Union[PathLike, Mapping[str, Any]],
+    table: Optional[PathLike] = None,
+    client: Any = None,
+    jobs: int = 0,
+    base_dir: Optional[PathLike] = None,
+):
+    """Runs a study, like ``fretdyn sweep``, and returns its table.
+
+    One row per finished run is appended to the CSV `table`; runs already in it are skipped
+    (run it again after a crash). Parameters drawn from distributions (``samples = N``,
+    docs/STUDIES.md) take the same values on a cluster as here (each draw is a function of
+    the study seed, the sample and the parameter); `percentiles` then gives P50/P95/P99 with
+    their errors.
+
+    Parameters
+    ----------
+    study : str, os.PathLike or Mapping
+        A study file, or a dict with its structure: ``base`` (the path of a case file,
+        relative to `base_dir`; a case as a dict; or a `Case`), ``parameters`` (a list of
+        ``{"key": key path, "values": [...]}`` or ``{"key", "distribution", "independent"}``),
+        and optionally ``combine``, ``seeds``, ``samples``, ``seed``, ``percentiles``.
+    table : str or os.PathLike, optional
+        The CSV table the rows go to; without it, a temporary file (removed after it is
+        read).
+    client : dask.distributed.Client, optional
+        Run each run as a task on this Dask cluster (the workers need this package and the
+        study's files); rows are written as tasks finish. Without it, on this machine.
+    jobs : int, default 0
+        Runs at a time on this machine (0: one per core).
+    base_dir : str or os.PathLike, optional
+        For a dict study: the folder its ``base`` path and the case's file names are
+        relative to (default: the current folder).
+
+    Returns
+    -------
+    pandas.DataFrame or numpy structured array
+        The whole table (every run in it, this call's and earlier ones'), sorted by run: a
+        DataFrame when pandas is installed (its ``attrs["runs_done"]`` is the number of runs
+        this call did), else a structured array.
+
+    Raises
+    ------
+    FretdynError
+        A bad study (naming the key, e.g. ``parameters[0].key``), or a run whose values make
+        an invalid case (before any run starts).
+
+    Examples
+    --------
+    >>> t = fretdyn.sweep("examples/study_clearance.toml", "study.csv")
+    >>> t = fretdyn.sweep({"base": case, "parameters": [
+    ...     {"key": "contacts.*.friction.mu", "values": [0.1, 0.2, 0.3]}]})
+    >>> t.plot(x="contacts.*.friction.mu", y="plane.wear_work_rate")
+    """
+    source = _study_source(study, base_dir)
+    if table is None:
+        with tempfile.TemporaryDirectory(prefix="fretdyn-sweep-") as tmp:
+            return sweep(study, Path(tmp) / "study.csv", client, jobs, base_dir)
     table = Path(table)
     if client is None:
-        return _native.study_local(study, os.fspath(table), jobs)
+        done = _native.study_local(source, os.fspath(table), jobs)
+    else:
+        done = _sweep_on_dask(source, table, client)
+    out = _frame(table)
+    if hasattr(out, "attrs"):
+        out.attrs["runs_done"] = done
+    return out
+
+
+def _sweep_on_dask(source: Any, table: Path, client: Any) -> int:
     from dask.distributed import as_completed
 
-    header = _native.study_header(study)
+    header = _native.study_header(source)
     done = _read_done(table, header)
     if table.exists() and table.stat().st_size > 0 and not table.read_text().endswith("\n"):
         text = table.read_text()
         table.write_text(text[: text.rfind("\n") + 1])
-    pending = [i for i in range(_native.study_runs(study)) if i not in done]
+    pending = [i for i in range(_native.study_runs(source)) if i not in done]
     with open(table, "a", newline="") as f:
         if not done and f.tell() == 0:
             f.write(header + "\n")
-        futures = [client.submit(_row, study, i, pure=False) for i in pending]
+        futures = [client.submit(_row, source, i, pure=False) for i in pending]
         for future in as_completed(futures):
             f.write(future.result() + "\n")
             f.flush()
     return len(pending)
 
 
-def percentiles(study: PathLike, table: PathLike, output: Optional[PathLike] = None) -> Optional[dict]:
-    """The percentiles (P50, P95, P99 by default) of a study's statistics across its samples,
-    from its table, as `fretdyn sweep` writes them in `percentiles.json` (docs/STUDIES.md):
-    `{"confidence", "bootstrap_resamples", "seed", "rows": [{"group", "column", "level", "n",
-    "excluded", "estimate", "ci_low", "ci_high", "ci_coverage", "bootstrap_se"}, ...]}`; the
-    interval is distribution-free (order statistics), `None` for a bound too few samples give.
-    A table written on a Dask cluster gives the same report as one written locally. With
-    `output` (a folder), `percentiles.csv` and `percentiles.json` are written there too.
-    `None` when the study asks for no percentiles (no `samples`, no `[percentiles]`)."""
+def percentiles(
+    study: Union[PathLike, Mapping[str, Any]],
+    table: PathLike,
+    output: Optional[PathLike] = None,
+    base_dir: Optional[PathLike] = None,
+) -> Optional[dict]:
+    """The percentiles of a study's statistics across its samples, as ``fretdyn sweep``
+    writes them in ``percentiles.json`` (docs/STUDIES.md).
+
+    The interval is distribution-free (order statistics); a table written on a Dask cluster
+    gives the same report as one written locally.
+
+    Parameters
+    ----------
+    study : str, os.PathLike or Mapping
+        The study file, or the dict, that `sweep` ran.
+    table : str or os.PathLike
+        Its table.
+    output : str or os.PathLike, optional
+        A folder to write ``percentiles.csv`` and ``percentiles.json`` into.
+    base_dir : str or os.PathLike, optional
+        For a dict study, as in `sweep`.
+
+    Returns
+    -------
+    dict or None
+        ``{"confidence", "bootstrap_resamples", "seed", "rows": [{"group", "column",
+        "level", "n", "excluded", "estimate", "ci_low", "ci_high", "ci_coverage",
+        "bootstrap_se"}, ...]}`` (P50, P95, P99 by default; ``None`` for a bound too few
+        samples give); ``None`` when the study asks for no percentiles (no ``samples``, no
+        ``[percentiles]``).
+
+    Examples
+    --------
+    >>> p = fretdyn.percentiles("examples/study_clearance_probabilistic.toml", "study.csv")
+    >>> [(r["column"], r["level"], r["estimate"]) for r in p["rows"]]
+    """
     out = _native.study_percentiles(
-        os.fspath(os.path.abspath(study)), os.fspath(table),
+        _study_source(study, base_dir), os.fspath(table),
         None if output is None else os.fspath(output),
     )
     return None if out is None else json.loads(out)
 
 
 def read_table(table: PathLike) -> dict:
-    """A study's table as a dict of numpy arrays (numbers) or lists (text), by column."""
+    """A study's table by column.
+
+    Parameters
+    ----------
+    table : str or os.PathLike
+        A CSV table written by `sweep` or ``fretdyn sweep``.
+
+    Returns
+    -------
+    dict
+        Column name → numpy array of floats (numbers; NaN where empty) or list of str (text),
+        complete rows only, in the order of the file.
+
+    Examples
+    --------
+    >>> t = fretdyn.read_table("study.csv")
+    >>> t["plane.wear_work_rate"]
+    """
     with open(table, newline="") as f:
         rows = list(csv.reader(f))
     header, body = rows[0], [r for r in rows[1:] if len(r) == len(rows[0])]
@@ -232,3 +901,6 @@ def read_table(table: PathLike) -> dict:
         except ValueError:
             out[name] = col
     return out
+
+
+from . import plot  # noqa: E402  (matplotlib is imported when a plot is drawn)

@@ -49,6 +49,7 @@ use serde::Deserialize;
 
 use super::percentiles::{PercentileReport, PercentileRequest, percentiles_of_table};
 use super::sampling::{Distribution, Stream};
+use crate::case::key_path::{KeyPath, KeyPathError, Missing, Part};
 use crate::case::{Case, check_case_text, parse_error};
 use crate::error::{Error, Result};
 use crate::integrator::simulation::{RunResults, RunSettings, Simulation, Termination};
@@ -186,7 +187,7 @@ pub struct PlotSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct StudyFile {
-    base: String,
+    base: Option<String>,
     #[serde(default)]
     combine: Combine,
     #[serde(default)]
@@ -260,27 +261,56 @@ impl Study {
     /// Reads a study file.
     pub fn from_file(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let value: toml::Value = toml::from_str(&text).map_err(|e| parse_error(&text, &e))?;
+        Self::from_toml_str(&text, path.parent().unwrap_or(Path::new(".")), None)
+    }
+
+    /// A study from the text of a study file; `dir` resolves its `base`. With `base_case`
+    /// (a case as TOML and the folder its file names are relative to), that is the base case
+    /// and the study gives no `base`.
+    pub fn from_toml_str(
+        text: &str,
+        dir: &Path,
+        base_case: Option<(toml::Value, PathBuf)>,
+    ) -> Result<Self> {
+        let value: toml::Value = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
         if value.get("base").is_none() && value.get("structure").is_some() {
             return Err(Error::invalid(
                 "base",
                 "this is a case file, not a study file (base = \"case.toml\" and [[parameters]]): run it with `fretdyn run <file>`",
             ));
         }
-        let file: StudyFile = toml::from_str(&text).map_err(|e| parse_error(&text, &e))?;
-        let dir = path.parent().unwrap_or(Path::new("."));
-        let base_path = dir.join(&file.base);
-        let base_text =
-            std::fs::read_to_string(&base_path).map_err(|e| Error::io(&base_path, e))?;
-        // the base case's own mistakes are reported with their line in it
-        check_case_text(&base_text)
-            .map_err(|e| Error::invalid("base", format!("{}: {e}", base_path.display())))?;
-        let base: toml::Value = toml::from_str(&base_text).map_err(|e| {
-            Error::invalid(
-                "base",
-                format!("{}: {}", base_path.display(), parse_error(&base_text, &e)),
-            )
-        })?;
+        let file: StudyFile = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
+        let (base, base_dir) = match (base_case, &file.base) {
+            (Some(_), Some(_)) => {
+                return Err(Error::invalid(
+                    "base",
+                    "the base case is given twice: remove base from the study",
+                ));
+            }
+            (Some((base, base_dir)), None) => (base, base_dir),
+            (None, None) => {
+                return Err(Error::invalid(
+                    "base",
+                    "missing: give base = \"case.toml\", the case file the study varies",
+                ));
+            }
+            (None, Some(name)) => {
+                let base_path = dir.join(name);
+                let base_text =
+                    std::fs::read_to_string(&base_path).map_err(|e| Error::io(&base_path, e))?;
+                // the base case's own mistakes are reported with their line in it
+                check_case_text(&base_text)
+                    .map_err(|e| Error::invalid("base", format!("{}: {e}", base_path.display())))?;
+                let base: toml::Value = toml::from_str(&base_text).map_err(|e| {
+                    Error::invalid(
+                        "base",
+                        format!("{}: {}", base_path.display(), parse_error(&base_text, &e)),
+                    )
+                })?;
+                let base_dir = base_path.parent().unwrap_or(Path::new(".")).to_path_buf();
+                (base, base_dir)
+            }
+        };
         let parameters = file
             .parameters
             .into_iter()
@@ -338,7 +368,7 @@ impl Study {
         };
         let study = Self {
             base,
-            base_dir: base_path.parent().unwrap_or(Path::new(".")).to_path_buf(),
+            base_dir,
             combine: file.combine,
             parameters,
             seeds: file.seeds,
@@ -360,7 +390,7 @@ impl Study {
             };
             let mut probe = self.base.clone();
             set_path(&mut probe, &p.key, &probe_value)
-                .map_err(|m| Error::invalid(format!("parameters[{k}].key"), m))?;
+                .map_err(|e| Error::invalid(format!("parameters[{k}].key"), e.to_string()))?;
         }
         if let Some(spec) = &self.percentiles {
             let header = self.header(&self.contact_names());
@@ -563,7 +593,8 @@ impl Study {
     pub fn case(&self, run: &RunSpec) -> Result<Case> {
         let mut value = self.base.clone();
         for (c, v) in self.columns().iter().zip(&run.values) {
-            set_path(&mut value, &c.key, v).map_err(|m| Error::invalid(c.key.clone(), m))?;
+            set_path(&mut value, &c.key, v)
+                .map_err(|e| Error::invalid(c.key.clone(), e.to_string()))?;
         }
         if let Some(seed) = run.seed {
             if let Some(toml::Value::Array(loads)) = value.get_mut("turbulence") {
@@ -995,43 +1026,14 @@ fn read_done(table: &Path, header: &str) -> Result<BTreeSet<usize>> {
         .collect())
 }
 
-/// Sets `key` (dotted, `*` for every element of an array, numbers for one element) in a TOML
-/// value; the path must exist.
+/// Sets `key` (a [`KeyPath`]: dotted, `*` for every element of an array, numbers or `[i]` for
+/// one element) in a TOML value; the path must exist.
 fn set_path(
     root: &mut toml::Value,
     key: &str,
     value: &toml::Value,
-) -> std::result::Result<(), String> {
-    fn go(
-        v: &mut toml::Value,
-        parts: &[&str],
-        value: &toml::Value,
-        key: &str,
-    ) -> std::result::Result<(), String> {
-        let Some((head, rest)) = parts.split_first() else {
-            *v = value.clone();
-            return Ok(());
-        };
-        let missing = || format!("'{key}': '{head}' is not in the base case");
-        match v {
-            toml::Value::Array(items) if *head == "*" => {
-                if items.is_empty() {
-                    return Err(missing());
-                }
-                items
-                    .iter_mut()
-                    .try_for_each(|item| go(item, rest, value, key))
-            }
-            toml::Value::Array(items) => {
-                let i: usize = head.parse().map_err(|_| missing())?;
-                go(items.get_mut(i).ok_or_else(missing)?, rest, value, key)
-            }
-            toml::Value::Table(t) => go(t.get_mut(*head).ok_or_else(missing)?, rest, value, key),
-            _ => Err(missing()),
-        }
-    }
-    let parts: Vec<&str> = key.split('.').collect();
-    go(root, &parts, value, key)
+) -> std::result::Result<(), KeyPathError> {
+    KeyPath::parse(key)?.set(root, value, Missing::Refuse)
 }
 
 /// Checks a `[[parameters]]` entry (number `k`).
@@ -1069,7 +1071,11 @@ fn parameter(k: usize, raw: RawParameter) -> Result<Parameter> {
             "applies to a drawn parameter (distribution = …): remove it, or give a distribution",
         ));
     }
-    if independent && !raw.key.split('.').any(|p| p == "*") {
+    let every = KeyPath::parse(&raw.key)
+        .map_err(|e| Error::invalid(format!("{field}.key"), e.to_string()))?
+        .parts
+        .contains(&Part::Every);
+    if independent && !every {
         return Err(Error::invalid(
             format!("{field}.independent"),
             format!(
@@ -1150,8 +1156,9 @@ fn columns(base: &toml::Value, parameters: &[Parameter]) -> Result<Vec<Column>> 
     let mut out = Vec::new();
     for (k, p) in parameters.iter().enumerate() {
         if p.independent {
-            let keys = expand(base, &p.key)
-                .map_err(|m| Error::invalid(format!("parameters[{k}].key"), m))?;
+            let keys = KeyPath::parse(&p.key)
+                .and_then(|path| path.expand(base))
+                .map_err(|e| Error::invalid(format!("parameters[{k}].key"), e.to_string()))?;
             out.extend(keys.into_iter().enumerate().map(|(e, key)| Column {
                 key,
                 parameter: k,
@@ -1165,62 +1172,5 @@ fn columns(base: &toml::Value, parameters: &[Parameter]) -> Result<Vec<Column>> 
             });
         }
     }
-    Ok(out)
-}
-
-/// Every concrete path of `key` in `root`: each `*` replaced by the indices of its array.
-fn expand(root: &toml::Value, key: &str) -> std::result::Result<Vec<String>, String> {
-    fn go(
-        v: &toml::Value,
-        parts: &[&str],
-        prefix: String,
-        key: &str,
-        out: &mut Vec<String>,
-    ) -> std::result::Result<(), String> {
-        let Some((head, rest)) = parts.split_first() else {
-            out.push(prefix);
-            return Ok(());
-        };
-        let join = |p: &str| {
-            if prefix.is_empty() {
-                p.to_string()
-            } else {
-                format!("{prefix}.{p}")
-            }
-        };
-        let missing = || format!("'{key}': '{head}' is not in the base case");
-        match v {
-            toml::Value::Array(items) if *head == "*" => {
-                if items.is_empty() {
-                    return Err(missing());
-                }
-                for (i, item) in items.iter().enumerate() {
-                    go(item, rest, join(&i.to_string()), key, out)?;
-                }
-                Ok(())
-            }
-            toml::Value::Array(items) => {
-                let i: usize = head.parse().map_err(|_| missing())?;
-                go(
-                    items.get(i).ok_or_else(missing)?,
-                    rest,
-                    join(head),
-                    key,
-                    out,
-                )
-            }
-            toml::Value::Table(t) => go(
-                t.get(*head).ok_or_else(missing)?,
-                rest,
-                join(head),
-                key,
-                out,
-            ),
-            _ => Err(missing()),
-        }
-    }
-    let parts: Vec<&str> = key.split('.').collect();
-    let mut out = Vec::new();
-    go(root, &parts, String::new(), key, &mut out)?;
     Ok(out)
 }

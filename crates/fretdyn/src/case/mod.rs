@@ -14,10 +14,12 @@
 //! - `life`: `[life]`, the service life of `fretdyn life`.
 //!
 //! This module reads the file, holds the top-level schema (`CaseFile`) and builds the
-//! sections in order.
+//! sections in order; [`key_path`] addresses its keys (`contacts[0].friction.mu`) for studies
+//! and the Python package.
 
 mod contacts;
 mod flow;
+pub mod key_path;
 mod life;
 mod loads;
 mod settings;
@@ -131,6 +133,38 @@ impl Case {
     pub fn stability(&self) -> Option<StabilityReport> {
         self.flow.as_ref().map(|f| f.connors(&self.model.basis))
     }
+}
+
+/// Makes the file names of a case read as TOML (as JSON: [`Case::echo`]) absolute, resolved
+/// from `base` as the case resolves them, so that the case reads the same files from any
+/// folder. The keys whose values are file names are `structure.file` (a `.npz` modal basis)
+/// and the `file` of every `history` table (a tabulated load history, `.csv` or `.npy`, of
+/// `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]` and `[base_excitation]`); a new key
+/// naming a file is added here.
+pub fn absolute_file_names(case: &mut serde_json::Value, base: &Path) {
+    fn absolute(file: &mut serde_json::Value, base: &Path) {
+        if let serde_json::Value::String(name) = file {
+            *name = base.join(&*name).to_string_lossy().into_owned();
+        }
+    }
+    fn histories(v: &mut serde_json::Value, base: &Path) {
+        match v {
+            serde_json::Value::Object(map) => {
+                for (k, item) in map.iter_mut() {
+                    match (k.as_str(), item.get_mut("file")) {
+                        ("history", Some(file)) => absolute(file, base),
+                        _ => histories(item, base),
+                    }
+                }
+            }
+            serde_json::Value::Array(items) => items.iter_mut().for_each(|i| histories(i, base)),
+            _ => {}
+        }
+    }
+    if let Some(file) = case.get_mut("structure").and_then(|s| s.get_mut("file")) {
+        absolute(file, base);
+    }
+    histories(case, base);
 }
 
 /// Checks that `text` reads as a case file (TOML syntax, known keys, types), without building

@@ -7,7 +7,8 @@
 //! - [`energy`]: the discrete energy balance (THEORY §5);
 //! - [`output`]: `results.npz` and `summary.json`;
 //! - [`stream`]: long runs streamed to disk by chunks, checkpoints and resume;
-//! - [`wear_map`]: where each contact's friction work is done, for the service life.
+//! - [`wear_map`]: where each contact's friction work is done, for the service life;
+//! - [`variables`]: names, dimensions, units and long names of the time histories.
 //!
 //! The step loop ([`crate::integrator`]) writes into [`recorder`], [`statistics`] and [`energy`];
 //! [`output`] and [`stream`] read the finished or running simulation.
@@ -17,4 +18,5 @@ pub mod output;
 pub mod recorder;
 pub mod statistics;
 pub mod stream;
+pub mod variables;
 pub mod wear_map;

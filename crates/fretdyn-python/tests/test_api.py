@@ -1,0 +1,484 @@
+"""The Python API against the CLI's files and against the README: `Result` (arrays, summary,
+impacts, blocks, contacts, `to_xarray`), `Case.with_`/`to_dict` against the same change made
+in the TOML text, studies given as dicts against the same study file, and the API page in
+the docs against the docstrings."""
+
+import importlib.util
+import json
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import fretdyn
+
+ROOT = Path(__file__).resolve().parents[3]
+EXAMPLES = ROOT / "examples"
+FRETDYN = os.environ.get("FRETDYN", str(ROOT / "target" / "release" / "fretdyn"))
+KEYS = [
+    "t", "q", "qdot", "contact_normal_force", "contact_tangential_force",
+    "contact_slip_velocity", "contact_penetration", "contact_status", "contact_position",
+]
+
+
+def cli(args, cwd):
+    return subprocess.run([FRETDYN, *args], cwd=cwd, capture_output=True, text=True)
+
+
+def same_bits(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def short_tube(tmp_path, duration="0.5"):
+    """The multi-span tube, shortened (impacts on several plates in half a second)."""
+    text = (EXAMPLES / "tube_multispan.toml").read_text()
+    assert "duration = 2.0" in text
+    path = tmp_path / "tube.toml"
+    path.write_text(text.replace("duration = 2.0", f"duration = {duration}"))
+    return path
+
+
+@pytest.fixture(scope="module")
+def tube_run(tmp_path_factory):
+    """The short tube run by the CLI (its folder) and by the package (its Result)."""
+    tmp = tmp_path_factory.mktemp("tube")
+    path = short_tube(tmp)
+    p = cli(["run", str(path), "-o", "out", "-q", "--no-plots"], tmp)
+    assert p.returncode == 0, p.stderr
+    return tmp / "out", fretdyn.run(path)
+
+
+# --- Result ---------------------------------------------------------------------------------
+
+
+def test_a_result_has_the_arrays_as_attributes_and_as_items(tube_run):
+    out, r = tube_run
+    npz = np.load(out / "results.npz")
+    assert list(r) == KEYS + ["summary"] and len(r) == len(KEYS) + 1
+    for k in KEYS:
+        assert getattr(r, k) is r[k]
+        assert same_bits(r[k], npz[k]), k
+    summary = json.loads((out / "summary.json").read_text())
+    assert r.summary is r["summary"]
+    assert r.summary["contacts"] == summary["contacts"]
+    assert r.contact_names == [c["name"] for c in summary["contacts"]]
+    assert r.contact_names == r.case.contact_names
+    assert "5 contacts" in repr(r) and "completed" in repr(r)
+
+
+def test_impacts_and_blocks_are_the_cli_tables(tube_run):
+    pd = pytest.importorskip("pandas")
+    out, r = tube_run
+    for table, path in ((r.impacts, out / "impacts.csv"), (r.blocks, out / "blocks.csv")):
+        assert isinstance(table, pd.DataFrame)
+        expected = pd.read_csv(path)
+        assert len(expected) > 5, path
+        assert list(table.columns) == list(expected.columns), path
+        for column in expected.columns:
+            a, b = table[column].to_numpy(), expected[column].to_numpy()
+            if a.dtype.kind == "f":
+                # the CSV has the shortest repr that reads back exactly
+                assert same_bits(a, b.astype(float)), (path.name, column)
+            else:
+                assert list(a) == list(b), (path.name, column)
+    i = r.impacts
+    k, start = i["contact"].to_numpy(), i["start"].to_numpy()
+    assert all(r.contact_names[c] == n for c, n in zip(k, i["name"]))
+    # every impact lies in the run; no peak above the contact's largest force (every step)
+    assert np.all((start >= 0) & (start + i["duration"] <= r.t[-1] + r.case.dt))
+    largest = np.array([c["normal_force_max"] for c in r.summary["contacts"]])
+    assert np.all(i["peak_force"].to_numpy() <= largest[k])
+    assert np.any(i["peak_force"].to_numpy() == largest[k])
+
+
+def test_the_contacts_table_is_the_summary_flattened(tube_run, tmp_path):
+    pd = pytest.importorskip("pandas")
+    out, r = tube_run
+    t = r.contacts
+    assert isinstance(t, pd.DataFrame)
+    assert list(t["name"]) == r.contact_names and t.columns[0] == "name"
+    for k, c in enumerate(r.summary["contacts"]):
+        for key, value in c.items():
+            if isinstance(value, (list, dict)):
+                assert key not in t.columns
+            elif isinstance(value, str):
+                assert t[key][k] == value
+            else:
+                assert t[key][k] == value, key
+    # with the CLI's contacts.csv (when it writes one): the same values in the same columns
+    csv = out / "contacts.csv"
+    if csv.exists():
+        cli_table = pd.read_csv(csv)
+        common = [c for c in t.columns if c in cli_table.columns]
+        assert "wear_work_rate" in common
+        for c in common:
+            if t[c].dtype.kind == "f":
+                assert np.array_equal(t[c].to_numpy(), cli_table[c].to_numpy(dtype=float),
+                                      equal_nan=True), c
+
+
+def test_without_pandas_the_tables_are_structured_arrays(tmp_path):
+    shadow = tmp_path / "shadow" / "pandas"
+    shadow.mkdir(parents=True)
+    (shadow / "__init__.py").write_text("raise ImportError('No module named pandas')\n")
+    script = tmp_path / "tables.py"
+    script.write_text(
+        "import json, sys, numpy as np, fretdyn\n"
+        f"r = fretdyn.run({str(short_tube(tmp_path, '0.2'))!r})\n"
+        "out = {}\n"
+        "for name in ('impacts', 'blocks', 'contacts'):\n"
+        "    t = getattr(r, name)\n"
+        "    assert isinstance(t, np.ndarray), type(t)\n"
+        "    out[name] = [list(t.dtype.names), len(t)]\n"
+        "out['peak'] = r.impacts['peak_force'].tolist()\n"
+        "out['names'] = r.contacts['name'].tolist()\n"
+        "out['wear'] = r.contacts['wear_work_rate'].tolist()\n"
+        "out['summary_wear'] = [c['wear_work_rate'] for c in r.summary['contacts']]\n"
+        "print(json.dumps(out))\n"
+    )
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(shadow.parent), env.get("PYTHONPATH", "")])
+    p = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["impacts"][0] == [
+        "contact", "name", "start", "duration", "contact_time", "peak_time", "peak_force",
+        "impulse", "impact_speed", "rebound_speed", "rebounds", "angle_deg",
+    ]
+    assert out["impacts"][1] == len(out["peak"]) > 0
+    assert out["blocks"][0][:4] == ["block", "t_start", "t_end", "name"]
+    assert out["contacts"][0][0] == "name" and out["contacts"][1] == 5
+    assert out["names"] == [f"plate{k}" for k in range(1, 6)]
+    assert out["wear"] == out["summary_wear"]
+
+
+def readme_units():
+    """The units the README's results.npz table gives, by key (its last `, unit` of the
+    meaning column; `m/s` as UDUNITS `m s-1`)."""
+    text = (ROOT / "README.md").read_text()
+    table = text.split("`results.npz` (N samples")[1].split("\n\n")[1]
+    units = {}
+    for line in table.splitlines()[2:]:
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        keys = re.findall(r"`(\w+)`", cells[0])
+        found = re.search(r",\s*(m/s|m|N|s)\s*(\(|$)", cells[2])
+        if found:
+            for k in keys:
+                units[k] = found.group(1).replace("m/s", "m s-1")
+    return units
+
+
+def test_to_xarray_has_the_names_dimensions_and_units_of_the_readme(tube_run):
+    xr = pytest.importorskip("xarray")
+    _, r = tube_run
+    ds = r.to_xarray()
+    assert isinstance(ds, xr.Dataset)
+    assert dict(ds.sizes) == {"time": len(r.t), "contact": 5, "mode": r.q.shape[1],
+                              "direction": 2}
+    assert list(ds.contact.values) == r.contact_names
+    assert list(ds.point.values) == r.case.contact_points
+    assert same_bits(ds.time.values, r.t)
+    assert np.array_equal(ds.mode.values, np.arange(1, r.q.shape[1] + 1))
+    assert np.allclose(ds.frequency.values, r.case.frequencies_hz, rtol=0, atol=0)
+    for k in KEYS[1:]:
+        assert same_bits(ds[k].values, r[k]), k
+    # the units are those of the README's table, where it gives one
+    units = readme_units()
+    assert set(units) >= {"t", "contact_normal_force", "contact_slip_velocity",
+                          "contact_penetration", "contact_position"}
+    for k, u in units.items():
+        name = "time" if k == "t" else k
+        assert ds[name].attrs["units"] == u, k
+    for name in [*ds.data_vars, *ds.coords]:
+        assert ds[name].attrs.get("long_name"), name
+    assert ds.contact_status.attrs["flag_meanings"] == "open stick slip"
+    assert list(ds.contact_status.attrs["flag_values"]) == [0, 1, 2]
+    # selecting by name gives the contact's column
+    k = r.contact_names.index("plate3")
+    assert same_bits(ds.contact_normal_force.sel(contact="plate3").values,
+                     r.contact_normal_force[:, k])
+    assert json.loads(ds.attrs["summary"]) == r.summary
+    assert ds.attrs["title"] == r.case.title
+
+
+def test_to_xarray_matches_the_cli_results_nc_where_there_is_one(tube_run):
+    """Once `fretdyn run` writes results.nc, it and to_xarray() describe the same variables
+    alike (one table of names and units in the library)."""
+    xr = pytest.importorskip("xarray")
+    out, r = tube_run
+    nc = out / "results.nc"
+    if not nc.exists():
+        pytest.skip("fretdyn run writes no results.nc")
+    ours = r.to_xarray()
+    with xr.open_dataset(nc) as theirs:
+        for name in ours.data_vars:
+            assert name in theirs, name
+            assert theirs[name].dims == ours[name].dims, name
+            assert theirs[name].attrs.get("units") == ours[name].attrs.get("units"), name
+            assert np.array_equal(theirs[name].values, ours[name].values), name
+
+
+def test_the_variables_table_describes_every_array(tube_run):
+    _, r = tube_run
+    names, coords = fretdyn.variables()
+    assert [v["name"] for v in names] == KEYS
+    sizes = {"time": len(r.t), "contact": 5, "mode": r.q.shape[1], "direction": 2}
+    for v in names:
+        assert r[v["name"]].shape == tuple(sizes[d] for d in v["dims"]), v["name"]
+    assert {c["name"] for c in coords} >= set(sizes)
+
+
+# --- Case.with_ and Case.to_dict ------------------------------------------------------------
+
+
+def test_with_equals_the_same_change_in_the_case_file():
+    path = EXAMPLES / "v1a_oblique_impact.toml"
+    text = path.read_text()
+    case = fretdyn.Case.from_file(path)
+    changed_text = (
+        text.replace("gap = 0.0", "gap = 1e-5").replace("friction = { mu = 0.3 }",
+                                                        "friction = { mu = 0.1 }")
+        .replace("every = 1 ", "every = 10 ")
+    )
+    assert changed_text.count("1e-5") == 1 and "mu = 0.1" in changed_text
+    assert "every = 10 " in changed_text
+    expected = fretdyn.run(fretdyn.Case.from_toml(changed_text))
+    forms = [
+        case.with_({"contacts[0].obstacle.gap": 1e-5, "contacts[0].friction.mu": 0.1},
+                   **{"output.every": 10}),
+        case.with_(**{"contacts.0.obstacle.gap": 1e-5, "contacts.*.friction.mu": 0.1,
+                      "output.every": np.int64(10)}),
+        case.with_({"contacts[0].friction": {"mu": 0.1}, "contacts[0].obstacle.gap": 1e-5,
+                    "output": {"every": 10}}),
+    ]
+    for changed in forms:
+        r = fretdyn.run(changed)
+        assert len(r.t) == 401
+        for k in KEYS:
+            assert same_bits(r[k], expected[k]), k
+    # the case itself is unchanged
+    assert case.to_dict()["contacts"][0]["obstacle"]["gap"] == 0.0
+    assert fretdyn.run(case).t.shape == (4001,)
+
+
+def test_with_adds_a_table_the_case_has_not():
+    # v1a has no [statistics]: t_start added, the window starts later
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    assert "statistics" not in case.to_dict()
+    later = case.with_(**{"statistics.t_start": 3.5e-3})
+    assert later.to_dict()["statistics"] == {"t_start": 3.5e-3}
+    r0, r1 = fretdyn.run(case), fretdyn.run(later)
+    # the impact (from 0 to half a period of the contact spring, π√(m/K) = 3.14 ms) is
+    # before the later window
+    assert r0.summary["contacts"][0]["impacts"] == 1
+    assert r1.summary["contacts"][0]["impacts"] == 0
+    assert same_bits(r0.q, r1.q)
+
+
+def test_errors_of_with_name_the_key_path():
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    cases = [
+        ({"contacts[0].obstacle.clearance": 2e-4},
+         "contacts[0].obstacle.clearance: unknown field `clearance`, expected one of"),
+        ({"contacts[1].obstacle.gap": 1e-4},
+         "contacts[1]: no such element; contacts has 1 element (index 0)"),
+        ({"contacts.obstacle.gap": 1e-4},
+         "contacts.obstacle: contacts is a list of 1: give an index (contacts[0])"),
+        ({"time.dt.value": 1e-6}, "time.dt.value: time.dt is a value"),
+        ({"time[0]": 1e-6}, "time[0]: time is a table, not a list: give one of its keys"),
+        ({"tim.dt": 1e-6}, "tim: unknown field `tim`, expected one of"),
+        ({"time.dt": "small"}, "time.dt: invalid type: string \"small\", expected f64"),
+        ({"contacts[0].normal.stiffness": -1.0}, "contacts[0].normal.stiffness: "),
+        ({"time.dt": None}, "time.dt: None is not a value"),
+        ({"contacts[0": 1.0}, "'contacts[0' is not a key path: a [ is not closed"),
+    ]
+    for changes, message in cases:
+        with pytest.raises(fretdyn.FretdynError) as e:
+            case.with_(changes)
+        assert str(e.value).startswith(message), (changes, str(e.value))
+        assert "line " not in str(e.value), str(e.value)
+
+
+def test_to_dict_round_trips_every_example():
+    examples = [p for p in sorted(EXAMPLES.glob("*.toml")) if not p.name.startswith("study_")]
+    assert len(examples) >= 10
+    for path in examples:
+        case = fretdyn.Case.from_file(path)
+        d = case.to_dict()
+        again = fretdyn.Case.from_dict(d)
+        assert again.to_dict() == d, path.name
+        assert again.title == case.title, path.name
+        for attr in ("dt", "steps", "modes", "contact_names", "contact_points"):
+            assert getattr(again, attr) == getattr(case, attr), (path.name, attr)
+        assert same_bits(again.frequencies_hz, case.frequencies_hz), path.name
+    # and runs the same, bit for bit
+    case = fretdyn.Case.from_file(EXAMPLES / "v1c_sliding_impact.toml")
+    a, b = fretdyn.run(case), fretdyn.run(fretdyn.Case.from_dict(case.to_dict()))
+    for k in KEYS:
+        assert same_bits(a[k], b[k]), k
+
+
+def test_to_dict_makes_file_names_absolute(tmp_path, monkeypatch):
+    """A case reading a .npz basis and a tabulated history next to it: its dict runs the same
+    from another folder."""
+    folder = tmp_path / "case"
+    folder.mkdir()
+    np.savez(folder / "basis.npz", frequencies_hz=np.array([0.0, 0.0, 0.0]),
+             rows_mass=np.eye(3), coords_mass=np.zeros(3))
+    (folder / "push.csv").write_text("t,value\n0.0,0.0\n1e-3,1.0\n4e-3,0.0\n")
+    (folder / "case.toml").write_text(
+        "[time]\ndt = 1e-6\nduration = 4e-3\n\n[structure]\ntype = \"modal\"\nfile = \"basis.npz\"\n\n"
+        "[[loads]]\npoint = \"mass\"\nforce = [0.0, 0.0, -10.0]\n"
+        "history = { type = \"table\", file = \"push.csv\" }\n\n"
+        "[[contacts]]\nname = \"plane\"\npoint = \"mass\"\n"
+        "obstacle = { type = \"plane\", origin = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], gap = 1e-6 }\n"
+        "normal = { stiffness = 1e6, damping = 0.0 }\nfriction = { mu = 0.3 }\n"
+    )
+    case = fretdyn.Case.from_file(folder / "case.toml")
+    assert case.base_dir == folder
+    d = case.to_dict()
+    assert d["structure"]["file"] == str(folder / "basis.npz")
+    assert d["loads"][0]["history"]["file"] == str(folder / "push.csv")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    with pytest.raises(fretdyn.FretdynError, match="basis.npz"):
+        # the relative names do not read from here
+        fretdyn.Case.from_dict(json.loads(json.dumps(d).replace(str(folder) + os.sep, "")))
+    a, b = fretdyn.run(case), fretdyn.run(fretdyn.Case.from_dict(d))
+    assert a.summary["contacts"][0]["impacts"] >= 1
+    for k in KEYS:
+        assert same_bits(a[k], b[k]), k
+    # a changed copy keeps reading them
+    c = fretdyn.run(case.with_(**{"contacts[0].friction.mu": 0.3}))
+    assert same_bits(c.q, a.q)
+
+
+# --- studies given as dicts -----------------------------------------------------------------
+
+
+STUDY = {
+    "parameters": [
+        {"key": "contacts.*.friction.mu", "values": [0.1, 0.3]},
+        {"key": "tangential.method", "values": ["gauss_seidel", "active_set"]},
+    ],
+}
+
+
+def table_rows(t):
+    """The rows of a study's DataFrame, without the wall-clock column."""
+    return t.drop(columns=["steps_per_second"]).astype(str).values.tolist()
+
+
+def test_a_study_as_a_dict_equals_the_study_file(tmp_path):
+    pd = pytest.importorskip("pandas")
+    (tmp_path / "v1a.toml").write_text((EXAMPLES / "v1a_oblique_impact.toml").read_text())
+    (tmp_path / "study.toml").write_text(
+        'base = "v1a.toml"\n\n[[parameters]]\nkey = "contacts.*.friction.mu"\nvalues = [0.1, 0.3]\n\n'
+        '[[parameters]]\nkey = "tangential.method"\nvalues = ["gauss_seidel", "active_set"]\n'
+    )
+    from_file = fretdyn.sweep(tmp_path / "study.toml", tmp_path / "file.csv")
+    assert isinstance(from_file, pd.DataFrame)
+    assert len(from_file) == 4 and from_file.attrs["runs_done"] == 4
+    assert list(from_file["run"]) == [0, 1, 2, 3]
+    assert list(from_file.columns) == (tmp_path / "file.csv").read_text().splitlines()[0].split(",")
+    case = fretdyn.Case.from_file(tmp_path / "v1a.toml")
+    bases = [
+        ("v1a.toml", dict(base_dir=tmp_path)),     # a path, relative to base_dir
+        (case, {}),                                 # a Case
+        (case.to_dict(), {}),                       # a case as a dict
+    ]
+    for base, kw in bases:
+        t = fretdyn.sweep({**STUDY, "base": base}, jobs=2, **kw)
+        assert table_rows(t) == table_rows(from_file), type(base)
+    # the table is written where asked, and a second sweep does nothing
+    t = fretdyn.sweep({**STUDY, "base": case}, tmp_path / "dict.csv")
+    assert t.attrs["runs_done"] == 4 and (tmp_path / "dict.csv").exists()
+    again = fretdyn.sweep({**STUDY, "base": case}, tmp_path / "dict.csv")
+    assert again.attrs["runs_done"] == 0 and table_rows(again) == table_rows(from_file)
+    # the statistic grows with the friction: the rows are those of their runs
+    mu = from_file["contacts.*.friction.mu"].to_numpy()
+    wear = from_file["plane.wear_work_rate"].to_numpy()
+    assert np.all(wear[mu == 0.3] != wear[mu == 0.1])
+
+
+def test_a_dict_study_on_a_dask_cluster_equals_the_local_one(tmp_path):
+    """The workers get the study as (JSON, folder) and build it again."""
+    pytest.importorskip("pandas")
+    distributed = pytest.importorskip("dask.distributed")
+    study = {**STUDY, "base": fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")}
+    local = fretdyn.sweep(study, tmp_path / "local.csv")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = fretdyn.sweep(study, tmp_path / "dask.csv", client=client)
+    assert remote.attrs["runs_done"] == 4
+    assert table_rows(remote) == table_rows(local)
+
+
+def test_a_probabilistic_dict_study_gives_its_percentiles(tmp_path):
+    pytest.importorskip("pandas")
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    study = {
+        "base": case, "samples": 5, "seed": 2,
+        "parameters": [{"key": "contacts[0].friction.mu",
+                        "distribution": {"type": "uniform", "low": 0.1, "high": 0.5}}],
+        "percentiles": {"statistics": ["wear_work_rate"], "levels": [50]},
+    }
+    t = fretdyn.sweep(study, tmp_path / "p.csv")
+    mu = t["contacts[0].friction.mu"].to_numpy()
+    assert len(t) == 5 and np.all((mu >= 0.1) & (mu < 0.5)) and len(set(mu)) == 5
+    p = fretdyn.percentiles(study, tmp_path / "p.csv")
+    (row,) = [r for r in p["rows"] if r["column"] == "plane.wear_work_rate"]
+    assert row["estimate"] == pytest.approx(np.percentile(t["plane.wear_work_rate"], 50), rel=1e-12)
+
+
+def test_errors_of_a_dict_study_name_the_key():
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    cases = [
+        ({"base": case, "parameters": [{"key": "contacts[0].obstacl.gap", "values": [0.0]}]},
+         "parameters[0].key: contacts[0].obstacl: no such key; contacts[0] has friction, name, normal, obstacle, point"),
+        ({"base": case, "parameters": [{"key": "time.dt", "valeus": [1e-6]}]},
+         "parameters[0].valeus: unknown field `valeus`"),
+        ({"base": case, "parameters": [{"key": "time.dt", "values": ["small"]}]},
+         "run 0 (time.dt = \"small\"): parameters[0].values: time.dt = \"small\" does not fit the case"),
+        ({"base": {**case.to_dict(), "time": {"dt": "small", "duration": 1e-3}},
+          "parameters": [{"key": "time.dt", "values": [1e-6]}]},
+         "base.time.dt: invalid type: string \"small\""),
+        ({"parameters": [{"key": "time.dt", "values": [1e-6]}]}, "base: missing"),
+        ({"base": "nothere.toml", "parameters": []}, "nothere.toml: "),
+    ]
+    for study, message in cases:
+        with pytest.raises(fretdyn.FretdynError) as e:
+            fretdyn.sweep(study)
+        assert message in str(e.value), (message, str(e.value))
+        assert "line " not in str(e.value), str(e.value)
+
+
+# --- the API page ---------------------------------------------------------------------------
+
+
+def api_doc():
+    spec = importlib.util.spec_from_file_location("python_api_doc", ROOT / "scripts" / "python_api_doc.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_api_page_is_generated_from_the_docstrings():
+    doc = api_doc()
+    page = (ROOT / "docs" / "PYTHON_API.md").read_text(encoding="utf-8")
+    assert page == doc.render(), (
+        "docs/PYTHON_API.md is not the page of the docstrings: run python scripts/python_api_doc.py"
+    )
+
+
+def test_everything_public_has_a_numpy_style_docstring():
+    doc = api_doc()
+    assert doc.undocumented() == []
