@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
 use fretdyn::integrator::simulation::{Progress, RunResults, Termination};
-use fretdyn::results::stream::{StreamObserver, StreamSettings};
+use fretdyn::results::stream::{ResultsMetadata, StreamObserver, StreamSettings};
 use ndarray::{Array3, Ix3};
 use ndarray_npy::NpzReader;
 use serde_json::json;
@@ -57,7 +57,7 @@ pub fn main(case: Option<&Path>, resume: Option<&Path>, options: &Options) -> Re
                 .output
                 .clone()
                 .unwrap_or_else(|| default_dir(&case.title, path));
-            let fingerprint = fingerprint_of(path)?;
+            let (fingerprint, text) = fingerprint_of(path)?;
             // bad input is refused before anything is written
             fretdyn::integrator::simulation::Simulation::check(&case.model, &case.settings)
                 .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
@@ -73,6 +73,7 @@ pub fn main(case: Option<&Path>, resume: Option<&Path>, options: &Options) -> Re
             run_and_write(
                 &case,
                 &path.display().to_string(),
+                Some(&text),
                 &dir,
                 options,
                 fingerprint,
@@ -191,8 +192,8 @@ fn free_space(dir: &Path) -> Option<u64> {
 }
 
 /// Refuses a run whose time histories cannot fit on the disk of its folder, and warns when
-/// packing them into `results.npz` at the end (as much again, until `series/` is removed)
-/// will not fit.
+/// packing them into `results.npz` and `results.nc` at the end (as much again each, until
+/// `series/` is removed) will not fit.
 fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
     let Some(free) = free_space(dir) else {
         return Ok(());
@@ -209,9 +210,9 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
             size(free)
         )));
     }
-    if needed.saturating_mul(2) > free {
+    if needed.saturating_mul(3) > free {
         errln!(
-            "warning: {}: the run will write {} of time histories in {}, where {} is free, and packing them into results.npz at the end needs as much again: free some space before the end (a run stopped by a full disk continues with fretdyn run --resume {})",
+            "warning: {}: the run will write {} of time histories in {}, where {} is free, and packing them into results.npz and results.nc at the end needs twice as much again: free some space before the end (a run stopped by a full disk continues with fretdyn run --resume {})",
             path.display(),
             size(needed),
             dir.display(),
@@ -222,11 +223,15 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Hash of the case file's text: a resumed run must use the case it started with.
-fn fingerprint_of(path: &Path) -> Result<u64, Failure> {
+/// Hash of the case file's text (a resumed run must use the case it started with), and the
+/// text (for `results.nc`).
+fn fingerprint_of(path: &Path) -> Result<(u64, String), Failure> {
     let bytes =
         std::fs::read(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
-    Ok(fretdyn::results::stream::fnv1a(&bytes))
+    Ok((
+        fretdyn::results::stream::fnv1a(&bytes),
+        String::from_utf8_lossy(&bytes).into_owned(),
+    ))
 }
 
 fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
@@ -251,7 +256,7 @@ fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
         )));
     }
     let case = load(&path)?;
-    let fingerprint = fingerprint_of(&path)?;
+    let (fingerprint, text) = fingerprint_of(&path)?;
     if info["fingerprint"].as_str() != Some(fingerprint.to_string().as_str()) {
         return Err(Failure::input(format!(
             "{}: the case file changed since the run in {} started; start the run again instead of resuming it",
@@ -262,6 +267,7 @@ fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
     run_and_write(
         &case,
         &path.display().to_string(),
+        Some(&text),
         dir,
         options,
         fingerprint,
@@ -278,11 +284,15 @@ fn default_dir(title: &str, path: &Path) -> PathBuf {
     PathBuf::from("fretdyn_results").join(stem)
 }
 
-/// Progress bar, Ctrl-C, and `summary.json` rewritten at each checkpoint and at the end.
+/// Progress bar, Ctrl-C, and `summary.json` rewritten at each checkpoint and at the end;
+/// the case file's text and the summary for `results.nc`.
 struct Observer<'a> {
     bar: Bar,
     case: &'a Case,
+    case_text: Option<&'a str>,
     dir: &'a Path,
+    /// The text of the last `summary.json` written at the end.
+    summary: Option<String>,
 }
 
 impl StreamObserver for Observer<'_> {
@@ -303,7 +313,17 @@ impl StreamObserver for Observer<'_> {
 
     fn finished(&mut self, results: &RunResults) -> fretdyn::Result<()> {
         let summary = fretdyn::results::output::summary(self.case, results);
-        fretdyn::results::output::write_summary(self.dir, &summary).map(|_| ())
+        let path = fretdyn::results::output::write_summary(self.dir, &summary)?;
+        self.summary = std::fs::read_to_string(&path).ok();
+        Ok(())
+    }
+
+    fn metadata(&self) -> ResultsMetadata {
+        ResultsMetadata {
+            title: Some(self.case.title.clone()),
+            case_toml: self.case_text.map(str::to_string),
+            summary_json: self.summary.clone(),
+        }
     }
 }
 
@@ -313,6 +333,7 @@ impl StreamObserver for Observer<'_> {
 pub fn run_and_write(
     case: &Case,
     source: &str,
+    case_text: Option<&str>,
     dir: &Path,
     options: &Options,
     fingerprint: u64,
@@ -325,7 +346,9 @@ pub fn run_and_write(
     let mut observer = Observer {
         bar: Bar::new(&case.title, !options.quiet),
         case,
+        case_text,
         dir,
+        summary: None,
     };
     let results = if resume {
         fretdyn::results::stream::resume(
@@ -569,7 +592,7 @@ fn demo(options: &Options) -> Result<(), Failure> {
         })?;
         let fingerprint = fretdyn::results::stream::fnv1a(case.title.as_bytes());
         let _lock = lock(&sub)?;
-        run_and_write(&case, "demo", &sub, options, fingerprint, false)?;
+        run_and_write(&case, "demo", None, &sub, options, fingerprint, false)?;
         let (t, f) = read_friction(&sub)?;
         let magnitude: Vec<f64> = (0..t.len())
             .map(|i| f[[i, 0, 0]].hypot(f[[i, 0, 1]]))

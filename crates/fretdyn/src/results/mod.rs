@@ -7,6 +7,7 @@
 //! - [`energy`]: the discrete energy balance (THEORY §5);
 //! - [`output`]: `results.npz` and `summary.json`;
 //! - [`stream`]: long runs streamed to disk by chunks, checkpoints and resume;
+//! - `netcdf` (feature `netcdf`): `results.nc`, the time histories with names and units;
 //! - [`wear_map`]: where each contact's friction work is done, for the service life;
 //! - [`variables`]: names, dimensions, units and long names of the time histories.
 //!
@@ -14,6 +15,8 @@
 //! [`output`] and [`stream`] read the finished or running simulation.
 
 pub mod energy;
+#[cfg(feature = "netcdf")]
+pub mod netcdf;
 pub mod output;
 pub mod recorder;
 pub mod statistics;

@@ -12,12 +12,14 @@
 //! - `checkpoint.bin`: the [`Snapshot`] with the length of every file at that step, written to
 //!   a temporary name and renamed; its format is in [`CHECKPOINT_MAGIC`];
 //! - at the end, `results.npz`, packed from `series/` (copied entry by entry, never whole in
-//!   memory), after which `series/` is removed.
+//!   memory), then (with the `netcdf` feature) `results.nc`, the same arrays with names and
+//!   units, packed from `series/` block by block (`results/netcdf.rs` says why at the
+//!   end and not at each flush); after which `series/` is removed.
 //!
 //! A run ends with a checkpoint at its last step, then [`StreamObserver::finished`] (where a
 //! front end writes its summary), then the packing: a run killed, or out of disk, before
-//! `results.npz` is in place is finished by [`resume`], which does those again; a last
-//! checkpoint with `results.npz` beside it is a complete run.
+//! `results.npz` (and `results.nc`) are in place is finished by [`resume`], which does those
+//! again; a last checkpoint with them beside it is a complete run.
 //!
 //! Memory does not grow with the run's length: the recorder holds one chunk, finished impacts
 //! and blocks are written out at each flush, and the statistics are running sums.
@@ -76,6 +78,23 @@ pub trait StreamObserver {
     fn finished(&mut self, _results: &RunResults) -> Result<()> {
         Ok(())
     }
+    /// What `results.nc` says of the run besides its arrays (the title, the case file, the
+    /// summary): asked once per packing, after [`Self::finished`].
+    fn metadata(&self) -> ResultsMetadata {
+        ResultsMetadata::default()
+    }
+}
+
+/// The global attributes of `results.nc` that the library does not know: a front end gives
+/// them through [`StreamObserver::metadata`]. Without the `netcdf` feature, not used.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ResultsMetadata {
+    /// The case's title.
+    pub title: Option<String>,
+    /// The text of the case file (TOML).
+    pub case_toml: Option<String>,
+    /// The text of `summary.json`.
+    pub summary_json: Option<String>,
 }
 
 /// An observer that only reports progress through a closure.
@@ -93,6 +112,17 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 pub const IMPACTS_FILE: &str = "impacts.csv";
 pub const BLOCKS_FILE: &str = "blocks.csv";
 pub const RESULTS_FILE: &str = "results.npz";
+/// `results.nc`, written with the `netcdf` feature (`results/netcdf.rs`).
+pub const NETCDF_FILE: &str = "results.nc";
+
+/// The files a complete run has packed from `series/`.
+fn packed_files() -> &'static [&'static str] {
+    if cfg!(feature = "netcdf") {
+        &[RESULTS_FILE, NETCDF_FILE]
+    } else {
+        &[RESULTS_FILE]
+    }
+}
 
 /// First bytes of `checkpoint.bin`. The file is: these 8 bytes, the format version
 /// ([`CHECKPOINT_FORMAT`], u32 little-endian), the length of the version of fretdyn that
@@ -132,6 +162,7 @@ pub fn run(
     std::fs::create_dir_all(dir.join(SERIES_DIR)).map_err(|e| Error::io(dir, e))?;
     let _ = std::fs::remove_file(dir.join(CHECKPOINT_FILE));
     let _ = std::fs::remove_file(dir.join(RESULTS_FILE));
+    let _ = std::fs::remove_file(dir.join(NETCDF_FILE));
     let files = Files::create(dir, model)?;
     drive(sim, files, settings, stream, fingerprint, observer)
 }
@@ -159,7 +190,7 @@ pub fn resume(
     }
     let ended =
         checkpoint.snapshot.step >= settings.steps || checkpoint.snapshot.target_met().is_some();
-    if ended && dir.join(RESULTS_FILE).exists() {
+    if ended && packed_files().iter().all(|f| dir.join(f).exists()) {
         // killed while removing series/, after the packing: what is left is not needed
         let _ = std::fs::remove_dir_all(dir.join(SERIES_DIR));
         return Err(Error::invalid(
@@ -178,13 +209,15 @@ pub fn resume(
         checkpoint.impacts_bytes,
         checkpoint.blocks_bytes,
     )?;
-    // the results.npz of a stop is packed again at the end; until then, a results.npz beside
-    // the last checkpoint is that of a complete run
-    match std::fs::remove_file(dir.join(RESULTS_FILE)) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            return Err(Error::io(dir.join(RESULTS_FILE), e));
+    // the results.npz (and results.nc) of a stop are packed again at the end; until then,
+    // they beside the last checkpoint are those of a complete run
+    for file in [RESULTS_FILE, NETCDF_FILE] {
+        match std::fs::remove_file(dir.join(file)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(Error::io(dir.join(file), e));
+            }
+            _ => {}
         }
-        _ => {}
     }
     drive(sim, files, settings, stream, fingerprint, observer)
 }
@@ -318,7 +351,10 @@ fn drive(
     files.write_blocks(&results.blocks)?;
     files.sync()?;
     observer.finished(&results)?;
-    files.pack(matches!(results.termination, Termination::Completed))?;
+    files.pack(
+        matches!(results.termination, Termination::Completed),
+        &observer.metadata(),
+    )?;
     results.impacts.clear();
     results.blocks.clear();
     Ok(results)
@@ -364,6 +400,9 @@ struct Files {
     impacts: BufWriter<File>,
     blocks: BufWriter<File>,
     model_contacts: Vec<String>,
+    /// The names and units of `results.nc`.
+    #[cfg(feature = "netcdf")]
+    labels: crate::results::netcdf::Labels,
 }
 
 impl Files {
@@ -393,6 +432,8 @@ impl Files {
             impacts,
             blocks,
             model_contacts: model.contacts.iter().map(|c| c.name.clone()).collect(),
+            #[cfg(feature = "netcdf")]
+            labels: crate::results::netcdf::Labels::of(model),
         };
         files.sync()?;
         Ok(files)
@@ -423,6 +464,8 @@ impl Files {
             impacts: reopen_at(&dir.join(IMPACTS_FILE), impacts_bytes)?,
             blocks: reopen_at(&dir.join(BLOCKS_FILE), blocks_bytes)?,
             model_contacts: model.contacts.iter().map(|c| c.name.clone()).collect(),
+            #[cfg(feature = "netcdf")]
+            labels: crate::results::netcdf::Labels::of(model),
         })
     }
 
@@ -460,11 +503,11 @@ impl Files {
         let order = [0, 1, 2, 3, 4, 5, 6, 8];
         for (data, &k) in f64s.iter().zip(&order) {
             let s = &mut self.series[k];
-            s.append_f64(&data[..n * s.row_len])?;
+            s.append_f64(&data[..n * s.row_len], n)?;
         }
         let s = &mut self.series[7];
         let status = r.status.as_slice().unwrap_or(&[]);
-        s.append_i8(&status[..n * s.row_len])?;
+        s.append_i8(&status[..n * s.row_len], n)?;
         Ok(())
     }
 
@@ -563,9 +606,10 @@ impl Files {
         })
     }
 
-    /// Packs `series/` into `results.npz` (stored entries, copied file by file); removes
-    /// `series/` when the run is complete (it is kept for a resume otherwise).
-    fn pack(&mut self, complete: bool) -> Result<()> {
+    /// Packs `series/` into `results.npz` (stored entries, copied file by file), then with
+    /// the `netcdf` feature into `results.nc` (with `meta`); removes `series/` when the run
+    /// is complete (it is kept for a resume otherwise).
+    fn pack(&mut self, complete: bool, meta: &ResultsMetadata) -> Result<()> {
         let path = self.dir.join(RESULTS_FILE);
         let series: Vec<(String, PathBuf)> = self
             .series
@@ -587,6 +631,23 @@ impl Files {
             }
             zip.finish().map_err(std::io::Error::other)?.flush()
         })?;
+        #[cfg(feature = "netcdf")]
+        {
+            let series: Vec<crate::results::netcdf::SeriesFile> = self
+                .series
+                .iter()
+                .map(|s| crate::results::netcdf::SeriesFile {
+                    key: &s.key,
+                    path: &s.path,
+                    dtype: s.dtype,
+                    row_shape: &s.row_shape,
+                    rows: s.rows,
+                })
+                .collect();
+            crate::results::netcdf::write(&self.dir, &series, &self.labels, meta)?;
+        }
+        #[cfg(not(feature = "netcdf"))]
+        let _ = meta;
         if complete {
             self.series.clear();
             let _ = std::fs::remove_dir_all(self.dir.join(SERIES_DIR));
@@ -678,8 +739,9 @@ fn reopen_at(path: &Path, len: u64) -> Result<BufWriter<File>> {
     Ok(BufWriter::new(file))
 }
 
+/// Element type of a series.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Dtype {
+pub(crate) enum Dtype {
     F64,
     I8,
 }
@@ -692,7 +754,7 @@ impl Dtype {
         }
     }
 
-    fn size(self) -> u64 {
+    pub(crate) fn size(self) -> u64 {
         match self {
             Dtype::F64 => 8,
             Dtype::I8 => 1,
@@ -701,7 +763,7 @@ impl Dtype {
 }
 
 /// Header room of the `.npy` files: fixed, so that the row count can be rewritten in place.
-const NPY_HEADER: usize = 256;
+pub(crate) const NPY_HEADER: usize = 256;
 
 /// A `.npy` file (format 1.0) that grows by rows.
 struct NpyAppender {
@@ -793,24 +855,29 @@ impl NpyAppender {
         Ok(())
     }
 
-    fn append_f64(&mut self, values: &[f64]) -> Result<()> {
+    /// Appends `rows` rows (`values` holds `rows × row_len` values: none for a row of
+    /// length 0, e.g. the contact arrays of a model without contacts).
+    fn append_f64(&mut self, values: &[f64], rows: usize) -> Result<()> {
         debug_assert_eq!(self.dtype, Dtype::F64);
+        debug_assert_eq!(values.len(), rows * self.row_len);
         for v in values {
             self.file
                 .write_all(&v.to_le_bytes())
                 .map_err(|e| Error::io(&self.path, e))?;
         }
-        self.rows += (values.len() / self.row_len.max(1)) as u64;
+        self.rows += rows as u64;
         self.write_header()
     }
 
-    fn append_i8(&mut self, values: &[i8]) -> Result<()> {
+    /// As [`Self::append_f64`].
+    fn append_i8(&mut self, values: &[i8], rows: usize) -> Result<()> {
         debug_assert_eq!(self.dtype, Dtype::I8);
+        debug_assert_eq!(values.len(), rows * self.row_len);
         let bytes: Vec<u8> = values.iter().map(|v| *v as u8).collect();
         self.file
             .write_all(&bytes)
             .map_err(|e| Error::io(&self.path, e))?;
-        self.rows += (values.len() / self.row_len.max(1)) as u64;
+        self.rows += rows as u64;
         self.write_header()
     }
 
