@@ -278,7 +278,8 @@ fn default_dir(title: &str, path: &Path) -> PathBuf {
     PathBuf::from("fretdyn_results").join(stem)
 }
 
-/// Progress bar, Ctrl-C, and `summary.json` rewritten at each checkpoint and at the end.
+/// Progress bar, Ctrl-C, and `summary.json` (and `contacts.csv`) rewritten at each checkpoint
+/// and at the end.
 struct Observer<'a> {
     bar: Bar,
     case: &'a Case,
@@ -296,15 +297,22 @@ impl StreamObserver for Observer<'_> {
     }
 
     fn checkpoint(&mut self, partial: &RunResults) {
-        let summary = fretdyn::results::output::summary(self.case, partial);
         // a failure here is reported by the final write
-        let _ = fretdyn::results::output::write_summary(self.dir, &summary);
+        let _ = write_summary(self.case, partial, self.dir);
     }
 
     fn finished(&mut self, results: &RunResults) -> fretdyn::Result<()> {
-        let summary = fretdyn::results::output::summary(self.case, results);
-        fretdyn::results::output::write_summary(self.dir, &summary).map(|_| ())
+        write_summary(self.case, results, self.dir)
     }
+}
+
+/// Writes `summary.json` and the same per-contact statistics as a table, `contacts.csv`
+/// (with `contacts_columns.csv`, their units and Code_Aster names).
+fn write_summary(case: &Case, results: &RunResults, dir: &Path) -> fretdyn::Result<()> {
+    let summary = fretdyn::results::output::summary(case, results);
+    fretdyn::results::output::write_summary(dir, &summary)?;
+    fretdyn::results::contacts_table::write_contacts_csv(dir, &summary)?;
+    Ok(())
 }
 
 /// Runs (or resumes) a case streamed into `dir`, writes `summary.json` and the plots, prints

@@ -6,12 +6,14 @@
 //! - [`statistics`]: per-contact wear work rate, impacts, slip, blocks (THEORY §5, §11);
 //! - [`energy`]: the discrete energy balance (THEORY §5);
 //! - [`output`]: `results.npz` and `summary.json`;
+//! - [`contacts_table`]: `contacts.csv`, the per-contact statistics as a table;
 //! - [`stream`]: long runs streamed to disk by chunks, checkpoints and resume;
 //! - [`wear_map`]: where each contact's friction work is done, for the service life.
 //!
 //! The step loop ([`crate::integrator`]) writes into [`recorder`], [`statistics`] and [`energy`];
 //! [`output`] and [`stream`] read the finished or running simulation.
 
+pub mod contacts_table;
 pub mod energy;
 pub mod output;
 pub mod recorder;
