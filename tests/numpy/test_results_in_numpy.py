@@ -1,6 +1,7 @@
 """The files fretdyn writes open in numpy in one call, and a basis written by numpy is read by
 fretdyn. Run by .ci/run in a venv with numpy and pytest; FRETDYN is the binary's path."""
 
+import csv
 import json
 import os
 import subprocess
@@ -112,3 +113,50 @@ def test_streamed_series_impacts_and_blocks_open_in_numpy(tmp_path):
         mine = blocks[blocks["name"] == c["name"]]
         work = np.sum(mine["wear_work_rate"] * (mine["t_end"] - mine["t_start"]))
         assert abs(work - c["wear_work"]) <= 1e-9 * max(c["wear_work"], 1e-30)
+
+
+def test_contacts_csv_opens_in_numpy_with_the_summary_numbers(tmp_path):
+    """contacts.csv: one row per contact of the case, in order; every cell is summary.json's
+    value (Python's float() and json read both exactly: equal floats are equal bits); a
+    column empty for a contact is a value summary.json does not have for it."""
+    for example in ("tube_three_span.toml", "tube_multispan_life.toml"):
+        out = tmp_path / example
+        p = run(["run", str(ROOT / "examples" / example), "-o", str(out), "-q", "--no-plots"], tmp_path)
+        assert p.returncode == 0, p.stderr
+        s = json.loads((out / "summary.json").read_text())
+        with open(out / "contacts.csv", newline="") as f:
+            rows = list(csv.DictReader(f))
+        assert [r["name"] for r in rows] == [c["name"] for c in s["contacts"]]
+        assert [r["contact"] for r in rows] == [str(k) for k in range(len(rows))]
+        for row, c in zip(rows, s["contacts"]):
+            for key, cell in row.items():
+                if key == "contact":
+                    continue
+                value = c.get(key)
+                if value is None:
+                    assert cell == "", (key, cell)
+                elif isinstance(value, bool):
+                    assert cell == str(value).lower(), key
+                elif isinstance(value, (int, float)):
+                    assert float(cell) == value and type(value)(cell) == value, (key, cell, value)
+                else:
+                    assert cell == value, key
+            # every statistic of the summary is a column (the histogram, a list, is not)
+            assert {k for k, v in c.items() if not isinstance(v, list)} <= set(row), c.keys()
+        # in one numpy call: numbers as floats and integers, names as strings
+        a = np.genfromtxt(out / "contacts.csv", delimiter=",", names=True, dtype=None, encoding=None)
+        assert a.shape == (len(s["contacts"]),)
+        assert list(a["name"]) == [c["name"] for c in s["contacts"]]
+        assert a["impacts"].dtype.kind == "i" and a["wear_work_rate"].dtype == np.float64
+        assert np.array_equal(a["wear_work_rate"], [c["wear_work_rate"] for c in s["contacts"]])
+        if example == "tube_multispan_life.toml":
+            # contacts with wear laws: their volume rates
+            assert np.all(a["tube_volume_rate"] > 0)
+            assert np.array_equal(a["tube_volume_rate"], [c["tube_volume_rate"] for c in s["contacts"]])
+    # the columns' units, meanings and Code_Aster names (quoted fields: the csv module)
+    with open(out / "contacts_columns.csv", newline="") as f:
+        columns = list(csv.DictReader(f))
+    assert [c["column"] for c in columns] == list(rows[0])
+    aster = {c["column"]: c["code_aster"] for c in columns}
+    assert aster["normal_wear_work_rate"] == "PUIS_USURE (PUIS_USURE)"
+    assert aster["impacts_per_second"] == "NB_CHOC_S (STAT_CHOC)"

@@ -284,8 +284,8 @@ fn default_dir(title: &str, path: &Path) -> PathBuf {
     PathBuf::from("fretdyn_results").join(stem)
 }
 
-/// Progress bar, Ctrl-C, and `summary.json` rewritten at each checkpoint and at the end;
-/// the case file's text and the summary for `results.nc`.
+/// Progress bar, Ctrl-C, and `summary.json` (and `contacts.csv`) rewritten at each checkpoint
+/// and at the end; the case file's text and the summary for `results.nc`.
 struct Observer<'a> {
     bar: Bar,
     case: &'a Case,
@@ -306,14 +306,12 @@ impl StreamObserver for Observer<'_> {
     }
 
     fn checkpoint(&mut self, partial: &RunResults) {
-        let summary = fretdyn::results::output::summary(self.case, partial);
         // a failure here is reported by the final write
-        let _ = fretdyn::results::output::write_summary(self.dir, &summary);
+        let _ = write_summary(self.case, partial, self.dir);
     }
 
     fn finished(&mut self, results: &RunResults) -> fretdyn::Result<()> {
-        let summary = fretdyn::results::output::summary(self.case, results);
-        let path = fretdyn::results::output::write_summary(self.dir, &summary)?;
+        let path = write_summary(self.case, results, self.dir)?;
         self.summary = std::fs::read_to_string(&path).ok();
         Ok(())
     }
@@ -325,6 +323,15 @@ impl StreamObserver for Observer<'_> {
             summary_json: self.summary.clone(),
         }
     }
+}
+
+/// Writes `summary.json` and the same per-contact statistics as a table, `contacts.csv`
+/// (with `contacts_columns.csv`, their units and Code_Aster names); returns the summary's path.
+fn write_summary(case: &Case, results: &RunResults, dir: &Path) -> fretdyn::Result<PathBuf> {
+    let summary = fretdyn::results::output::summary(case, results);
+    let path = fretdyn::results::output::write_summary(dir, &summary)?;
+    fretdyn::results::contacts_table::write_contacts_csv(dir, &summary)?;
+    Ok(path)
 }
 
 /// Runs (or resumes) a case streamed into `dir`, writes `summary.json` and the plots, prints

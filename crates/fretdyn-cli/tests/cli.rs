@@ -792,10 +792,13 @@ fn resumed_equals(cwd: &Path, dir: &str, full: &Path) {
     for key in ["contacts", "energy_balance", "time"] {
         assert_eq!(a[key], b[key], "{key}");
     }
-    assert_eq!(
-        std::fs::read_to_string(full.join("impacts.csv")).unwrap(),
-        std::fs::read_to_string(dir.join("impacts.csv")).unwrap()
-    );
+    for table in ["impacts.csv", "contacts.csv"] {
+        assert_eq!(
+            std::fs::read_to_string(full.join(table)).unwrap(),
+            std::fs::read_to_string(dir.join(table)).unwrap(),
+            "{table}"
+        );
+    }
     // and then it is complete
     let out = fretdyn(&["run", "--resume", dir.to_str().unwrap(), "-q"], cwd);
     assert_one_line_error(&out, 2, &["nothing to resume"]);
