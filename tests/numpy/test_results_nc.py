@@ -31,12 +31,14 @@ DIMS = {
     "contact_position": ("time", "contact", "local_axis"),
 }
 
-# SI units of the README's table
+# SI units of the README's table (UDUNITS spelling)
 UNITS = {
     "t": "s",
+    "q": "kg^0.5 m",
+    "qdot": "kg^0.5 m s-1",
     "contact_normal_force": "N",
     "contact_tangential_force": "N",
-    "contact_slip_velocity": "m/s",
+    "contact_slip_velocity": "m s-1",
     "contact_penetration": "m",
     "contact_position": "m",
 }
@@ -78,9 +80,17 @@ def test_results_nc_opens_in_xarray_with_the_numbers_of_results_npz(case, tmp_pa
             assert np.array_equal(forces.values, r["contact_normal_force"][:, -1])
         assert ds.sizes["mode"] == r["q"].shape[1]
         assert list(ds["tangent"].values) == ["t1", "t2"]
+        assert list(ds["local_axis"].values) == ["e1", "e2"]
         assert list(ds["direction"].values) == ["x", "y", "z"]
         assert ds["point"].size >= 1
         assert set(ds["contact_point"].values) <= set(ds["point"].values)
+        # the auxiliary coordinates are coordinates, not data variables
+        for name in ["frequency", "damping_ratio", "contact_point", "contact_obstacle",
+                     "point_position"]:
+            assert name in ds.coords, name
+        assert set(ds.data_vars) == set(DIMS) - {"t"}
+        assert ds["contact_status"].attrs["flag_meanings"] == "open stick slip"
+        assert list(ds["contact_status"].attrs["flag_values"]) == [0, 1, 2]
         # units and long_name on every numeric variable, a long_name on the name labels
         for name, v in ds.variables.items():
             assert v.attrs.get("long_name"), name

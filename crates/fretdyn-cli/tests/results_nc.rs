@@ -315,7 +315,9 @@ fn results_nc_has_the_arrays_of_results_npz_with_names_and_units() {
         ("time", "s"),
         ("contact_normal_force", "N"),
         ("contact_tangential_force", "N"),
-        ("contact_slip_velocity", "m/s"),
+        ("contact_slip_velocity", "m s-1"),
+        ("q", "kg^0.5 m"),
+        ("qdot", "kg^0.5 m s-1"),
         ("contact_penetration", "m"),
         ("contact_position", "m"),
         ("contact_status", "1"),
@@ -324,6 +326,40 @@ fn results_nc_has_the_arrays_of_results_npz_with_names_and_units() {
     ] {
         assert_eq!(nc.vars[name].attrs["units"], units, "{name}");
     }
+
+    // the names, dimensions, units and long names are those of the one table the Python
+    // package's to_xarray() takes them from, and nothing else
+    let table = fretdyn::results::variables::time_histories(true);
+    let described: Vec<(&str, &[&str], Option<&str>, &str)> = table
+        .iter()
+        .map(|h| &h.variable)
+        .chain(
+            fretdyn::results::variables::COORDINATES
+                .iter()
+                .map(|c| &c.variable),
+        )
+        .map(|v| (v.name, v.dims, v.units, v.long_name))
+        .collect();
+    assert_eq!(described.len(), nc.vars.len(), "{:?}", nc.vars.keys());
+    for (name, dims, units, long_name) in described {
+        let var = &nc.vars[name];
+        let var_dims: Vec<&str> = var.dims.iter().map(|d| d.0.as_str()).collect();
+        assert_eq!(var_dims, dims, "{name}");
+        assert_eq!(var.attrs.get("units").map(String::as_str), units, "{name}");
+        assert_eq!(var.attrs["long_name"], long_name, "{name}");
+    }
+    assert_eq!(
+        nc.vars["contact_status"].attrs["flag_meanings"],
+        "open stick slip"
+    );
+    // auxiliary coordinates, CF: on the variables along their dimensions, point_position
+    // in the global attribute (xarray's convention)
+    assert_eq!(nc.vars["q"].attrs["coordinates"], "frequency damping_ratio");
+    assert_eq!(
+        nc.vars["contact_position"].attrs["coordinates"],
+        "contact_point contact_obstacle"
+    );
+    assert_eq!(nc.attrs["coordinates"], "point_position");
 
     // the case and the summary
     assert_eq!(

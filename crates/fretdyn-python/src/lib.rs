@@ -438,27 +438,75 @@ fn blocks<'py>(
     Ok(out)
 }
 
-/// The names, dimensions, units and long names of the time histories of a run
-/// (`fretdyn::results::variables::VARIABLES`, the keys of `results.npz`) and of the
-/// coordinates along their dimensions (`COORDINATES`): two lists of dicts with the keys
-/// `name`, `dims`, `units`, `long_name`, `flag_meanings`.
+/// A variable of `fretdyn::results::variables` as a dict: `name`, `dims`, `units` (None for
+/// names), `long_name`, `flag_meanings`.
+fn variable_dict<'py>(
+    py: Python<'py>,
+    v: &fretdyn::results::variables::Variable,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("name", v.name)?;
+    d.set_item("dims", v.dims.to_vec())?;
+    d.set_item("units", v.units)?;
+    d.set_item("long_name", v.long_name)?;
+    d.set_item("flag_meanings", v.flag_meanings.to_vec())?;
+    Ok(d)
+}
+
+/// The one table of names, dimensions, units and long names (`fretdyn::results::variables`,
+/// which `results.nc` is written from): the time histories of a run of a modal model
+/// (`modal`) or of one in physical coordinates, in the order of `results.npz`, each a dict
+/// with `key` (of `results.npz`), `name`, `dims`, `units`, `long_name`, `flag_meanings` and
+/// `coordinates` (its auxiliary coordinates, CF); and the coordinates besides `time` (the
+/// same keys but `key` and `coordinates`).
 #[pyfunction]
-fn variables<'py>(py: Python<'py>) -> PyResult<(Bound<'py, PyList>, Bound<'py, PyList>)> {
-    use fretdyn::results::variables::{COORDINATES, VARIABLES, Variable};
-    let list = |table: &[Variable]| -> PyResult<Bound<'py, PyList>> {
-        let out = PyList::empty(py);
-        for v in table {
-            let d = PyDict::new(py);
-            d.set_item("name", v.name)?;
-            d.set_item("dims", v.dims.to_vec())?;
-            d.set_item("units", v.units)?;
-            d.set_item("long_name", v.long_name)?;
-            d.set_item("flag_meanings", v.flag_meanings.to_vec())?;
-            out.append(d)?;
+#[pyo3(signature = (modal = true))]
+fn variables<'py>(
+    py: Python<'py>,
+    modal: bool,
+) -> PyResult<(Bound<'py, PyList>, Bound<'py, PyList>)> {
+    use fretdyn::results::variables::{COORDINATES, auxiliary_coordinates, time_histories};
+    let histories = PyList::empty(py);
+    for h in time_histories(modal) {
+        let d = variable_dict(py, &h.variable)?;
+        d.set_item("key", h.key)?;
+        d.set_item("coordinates", auxiliary_coordinates(h.variable.dims))?;
+        histories.append(d)?;
+    }
+    let coordinates = PyList::empty(py);
+    for c in &COORDINATES {
+        coordinates.append(variable_dict(py, &c.variable)?)?;
+    }
+    Ok((histories, coordinates))
+}
+
+/// The values of the coordinates of a case's results besides `time` (`fretdyn::results::
+/// variables::COORDINATES`, as `results.nc` has them): a dict name → numpy array (int32 mode
+/// numbers, float64 numbers in the shape of their dimensions) or list of str (names); and
+/// whether the case's model is modal (else in physical coordinates).
+#[pyfunction]
+fn coordinates<'py>(py: Python<'py>, case: &Case) -> PyResult<(Bound<'py, PyDict>, bool)> {
+    use fretdyn::results::variables::{COORDINATES, Labels, Values};
+    let labels = Labels::of(&case.inner.model);
+    let out = PyDict::new(py);
+    for c in &COORDINATES {
+        let v = &c.variable;
+        let shape: Vec<usize> = v
+            .dims
+            .iter()
+            .map(|d| labels.dimension_len(d).unwrap_or(0))
+            .collect();
+        match labels.values(c.source) {
+            Values::Text(names) => out.set_item(v.name, names)?,
+            Values::Int(numbers) => {
+                out.set_item(v.name, PyArray1::from_vec(py, numbers).reshape(shape)?)?
+            }
+            Values::Float(numbers) => {
+                out.set_item(v.name, PyArray1::from_vec(py, numbers).reshape(shape)?)?
+            }
         }
-        Ok(out)
-    };
-    Ok((list(&VARIABLES)?, list(&COORDINATES)?))
+    }
+    Ok((out, labels.modal()))
 }
 
 /// The Connors fluid-elastic stability check of every mode of a case with a `[flow]` section
@@ -607,6 +655,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(case_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(case_with, m)?)?;
     m.add_function(wrap_pyfunction!(variables, m)?)?;
+    m.add_function(wrap_pyfunction!(coordinates, m)?)?;
+    m.add("RESULTS_COMMENT", fretdyn::results::variables::COMMENT)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(study_runs, m)?)?;

@@ -158,20 +158,25 @@ def test_without_pandas_the_tables_are_structured_arrays(tmp_path):
     assert out["wear"] == out["summary_wear"]
 
 
-def readme_units():
-    """The units the README's results.npz table gives, by key (its last `, unit` of the
-    meaning column; `m/s` as UDUNITS `m s-1`)."""
+def readme_table():
+    """The README's table of the arrays of results.npz and results.nc: key → (dimensions,
+    units), from its columns "dimensions in `results.nc`" and "units"."""
     text = (ROOT / "README.md").read_text()
     table = text.split("`results.npz` (N samples")[1].split("\n\n")[1]
-    units = {}
-    for line in table.splitlines()[2:]:
+    lines = table.splitlines()
+    header = [c.strip() for c in lines[0].strip("|").split("|")]
+    assert header[:4] == ["key", "shape", "dimensions in `results.nc`", "units"], header
+    out = {}
+    for line in lines[2:]:
         cells = [c.strip() for c in line.strip("|").split("|")]
         keys = re.findall(r"`(\w+)`", cells[0])
-        found = re.search(r",\s*(m/s|m|N|s)\s*(\(|$)", cells[2])
-        if found:
-            for k in keys:
-                units[k] = found.group(1).replace("m/s", "m s-1")
-    return units
+        dims = tuple(re.findall(r"`(\w+)`", cells[2]))
+        units = [u.strip() for u in cells[3].split(",")]
+        if len(units) == 1:
+            units = units * len(keys)
+        for k, u in zip(keys, units):
+            out[k] = (dims, u)
+    return out
 
 
 def test_to_xarray_has_the_names_dimensions_and_units_of_the_readme(tube_run):
@@ -179,59 +184,145 @@ def test_to_xarray_has_the_names_dimensions_and_units_of_the_readme(tube_run):
     _, r = tube_run
     ds = r.to_xarray()
     assert isinstance(ds, xr.Dataset)
+    points = [p["name"] for p in r.summary["case"]["structure"]["points"]]
     assert dict(ds.sizes) == {"time": len(r.t), "contact": 5, "mode": r.q.shape[1],
-                              "direction": 2}
+                              "tangent": 2, "local_axis": 2, "direction": 3,
+                              "point": len(points)}
+    assert list(ds.point.values) == points
     assert list(ds.contact.values) == r.contact_names
-    assert list(ds.point.values) == r.case.contact_points
+    assert list(ds.contact_point.values) == r.case.contact_points
+    assert list(ds.contact_obstacle.values) == ["circle"] * 5
+    at = {p["name"]: p["at"] for p in r.summary["case"]["structure"]["points"]}
+    for name in points:
+        assert np.array_equal(ds.point_position.sel(point=name).values, at[name]), name
+    assert list(ds.tangent.values) == ["t1", "t2"]
+    assert list(ds.local_axis.values) == ["e1", "e2"]
+    assert list(ds.direction.values) == ["x", "y", "z"]
+    assert ds.point_position.dims == ("point", "direction")
     assert same_bits(ds.time.values, r.t)
     assert np.array_equal(ds.mode.values, np.arange(1, r.q.shape[1] + 1))
     assert np.allclose(ds.frequency.values, r.case.frequencies_hz, rtol=0, atol=0)
+    assert "frequency" in ds.coords and "point_position" in ds.coords
     for k in KEYS[1:]:
         assert same_bits(ds[k].values, r[k]), k
-    # the units are those of the README's table, where it gives one
-    units = readme_units()
-    assert set(units) >= {"t", "contact_normal_force", "contact_slip_velocity",
-                          "contact_penetration", "contact_position"}
-    for k, u in units.items():
+    # the dimensions and units are those of the README's table
+    table = readme_table()
+    assert list(table) == KEYS
+    for k, (dims, units) in table.items():
         name = "time" if k == "t" else k
-        assert ds[name].attrs["units"] == u, k
+        assert ds[name].dims == dims, k
+        assert ds[name].attrs["units"] == units, k
     for name in [*ds.data_vars, *ds.coords]:
         assert ds[name].attrs.get("long_name"), name
+        # numbers have units, names have none
+        assert ("units" in ds[name].attrs) == (ds[name].dtype.kind in "fiu"), name
     assert ds.contact_status.attrs["flag_meanings"] == "open stick slip"
     assert list(ds.contact_status.attrs["flag_values"]) == [0, 1, 2]
     # selecting by name gives the contact's column
     k = r.contact_names.index("plate3")
     assert same_bits(ds.contact_normal_force.sel(contact="plate3").values,
                      r.contact_normal_force[:, k])
+    assert same_bits(ds.contact_slip_velocity.sel(contact="plate3", tangent="t2").values,
+                     r.contact_slip_velocity[:, k, 1])
     assert json.loads(ds.attrs["summary"]) == r.summary
     assert ds.attrs["title"] == r.case.title
 
 
-def test_to_xarray_matches_the_cli_results_nc_where_there_is_one(tube_run):
-    """Once `fretdyn run` writes results.nc, it and to_xarray() describe the same variables
-    alike (one table of names and units in the library)."""
+def test_to_xarray_is_the_dataset_of_the_cli_results_nc(tube_run, tmp_path):
+    """to_xarray() and xarray.open_dataset("results.nc") of the same case are the same
+    Dataset: variable by variable the same names, dimensions, coordinates, attributes
+    (units, long_name, flag_*) and numbers (bit for bit, same dtype); the same global
+    attributes but `case` (the case file's text, which a Case need not have) and `summary`
+    (the same but for the wall time). And to_netcdf of it reads back as the same."""
     xr = pytest.importorskip("xarray")
+    pytest.importorskip("netCDF4")
     out, r = tube_run
-    nc = out / "results.nc"
-    if not nc.exists():
-        pytest.skip("fretdyn run writes no results.nc")
     ours = r.to_xarray()
-    with xr.open_dataset(nc) as theirs:
-        for name in ours.data_vars:
-            assert name in theirs, name
-            assert theirs[name].dims == ours[name].dims, name
-            assert theirs[name].attrs.get("units") == ours[name].attrs.get("units"), name
-            assert np.array_equal(theirs[name].values, ours[name].values), name
+    with xr.open_dataset(out / "results.nc") as theirs:
+        theirs = theirs.load()
+    assert set(ours.variables) == set(theirs.variables)
+    assert set(ours.coords) == set(theirs.coords)
+    assert set(ours.data_vars) == set(theirs.data_vars)
+    for name in ours.variables:
+        a, b = ours[name].variable, theirs[name].variable
+        assert a.dims == b.dims, name
+        assert a.attrs.keys() == b.attrs.keys(), name
+        for key in ("units", "long_name", "flag_meanings"):
+            assert a.attrs.get(key) == b.attrs.get(key), (name, key)
+        assert a.dtype == b.dtype or a.dtype.kind == b.dtype.kind == "U", name
+        if a.dtype.kind == "U":
+            assert a.values.tolist() == b.values.tolist(), name
+        else:
+            assert same_bits(a.values, b.values), name
+    # the whole Dataset, coordinates and attributes included
+    without = ["case", "summary"]
+    xr.testing.assert_identical(ours.drop_attrs(deep=False),
+                                theirs.drop_attrs(deep=False))
+    assert {k: v for k, v in ours.attrs.items() if k not in without} == {
+        k: v for k, v in theirs.attrs.items() if k not in without}
+    summary = {k: v for k, v in json.loads(theirs.attrs["summary"]).items()
+               if k != "performance"}
+    assert summary == {k: v for k, v in json.loads(ours.attrs["summary"]).items()
+                       if k != "performance"}
+    # to_netcdf writes what open_dataset reads back as the same Dataset
+    ours.to_netcdf(tmp_path / "ours.nc")
+    with xr.open_dataset(tmp_path / "ours.nc") as again:
+        xr.testing.assert_identical(again.load(), ours)
+
+
+def no_contact_case(tmp_path):
+    """The clamped tube with its one contact taken out: zero-length contact arrays."""
+    text = (EXAMPLES / "tube_clamped_one_support.toml").read_text()
+    i, j = text.index("[[contacts]]"), text.index("[[loads]]")
+    path = tmp_path / "no_contact.toml"
+    path.write_text(text[:i] + text[j:])
+    return path
+
+
+@pytest.mark.parametrize(
+    "case",
+    [*sorted(p.name for p in EXAMPLES.glob("*.toml") if not p.name.startswith("study_")),
+     "no contact"],
+)
+def test_to_xarray_is_open_dataset_of_results_nc_for_every_example(case, tmp_path):
+    """For every example (and a case without contacts), `fretdyn run`'s results.nc opened by
+    xarray and the package's to_xarray() are the same Dataset, attributes but `case` and
+    `summary` included, with the numbers of results.npz."""
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("netCDF4")
+    path = no_contact_case(tmp_path) if case == "no contact" else EXAMPLES / case
+    p = cli(["run", str(path), "-o", "out", "-q", "--no-plots"], tmp_path)
+    assert p.returncode == 0, p.stderr
+    ours = fretdyn.run(path).to_xarray()
+    with xr.open_dataset(tmp_path / "out" / "results.nc") as theirs:
+        theirs = theirs.load()
+    xr.testing.assert_identical(ours.drop_attrs(deep=False), theirs.drop_attrs(deep=False))
+    assert {k: ours.attrs[k] for k in ("title", "fretdyn_version", "comment")} == {
+        k: theirs.attrs[k] for k in ("title", "fretdyn_version", "comment")}
+    npz = np.load(tmp_path / "out" / "results.npz")
+    for v in fretdyn.variables()[0]:
+        assert ours[v["name"]].dtype == theirs[v["name"]].dtype == npz[v["key"]].dtype
+        assert same_bits(ours[v["name"]].values, npz[v["key"]]), (case, v["key"])
 
 
 def test_the_variables_table_describes_every_array(tube_run):
     _, r = tube_run
     names, coords = fretdyn.variables()
-    assert [v["name"] for v in names] == KEYS
-    sizes = {"time": len(r.t), "contact": 5, "mode": r.q.shape[1], "direction": 2}
+    assert [v["key"] for v in names] == KEYS
+    assert [v["name"] for v in names] == ["time", *KEYS[1:]]
+    sizes = {"time": len(r.t), "contact": 5, "mode": r.q.shape[1], "tangent": 2,
+             "local_axis": 2}
     for v in names:
-        assert r[v["name"]].shape == tuple(sizes[d] for d in v["dims"]), v["name"]
-    assert {c["name"] for c in coords} >= set(sizes)
+        assert r[v["key"]].shape == tuple(sizes[d] for d in v["dims"]), v["key"]
+    # every dimension has its coordinate
+    assert {c["name"] for c in coords} >= set(sizes) - {"time"}
+    units = {v["key"]: v["units"] for v in names}
+    assert (units["q"], units["qdot"]) == ("kg^0.5 m", "kg^0.5 m s-1")
+    # a model in physical coordinates: q in m
+    physical = {v["key"]: v["units"] for v in fretdyn.variables(modal=False)[0]}
+    assert (physical["q"], physical["qdot"]) == ("m", "m s-1")
+    assert {k: u for k, u in physical.items() if k not in ("q", "qdot")} == {
+        k: u for k, u in units.items() if k not in ("q", "qdot")}
 
 
 # --- Case.with_ and Case.to_dict ------------------------------------------------------------

@@ -42,7 +42,7 @@ def close_figures():
 
 
 def units(name):
-    return {v["name"]: v["units"] for v in fretdyn.variables()[0]}[name]
+    return {v["key"]: v["units"] for v in fretdyn.variables()[0]}[name]
 
 
 def looked_at(ax, path):
@@ -99,7 +99,7 @@ def test_orbits_of_one_contact_on_given_axes(tube, v1a, tmp_path):
     ax = fretdyn.plot.orbits(v1a)
     assert len(ax.get_lines()) == 1
     assert np.array_equal(ax.get_lines()[0].get_xydata(), v1a.contact_position[:, 0, :])
-    assert ax.get_xlabel() == "distance from the plane (m)"
+    assert ax.get_xlabel() == "e1, distance from the plane (m)"
     with pytest.raises(ValueError, match="plate9.*plate1"):
         fretdyn.plot.orbits(tube, contact="plate9")
     with pytest.raises(ValueError, match="no contact 5"):

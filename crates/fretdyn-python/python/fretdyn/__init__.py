@@ -83,39 +83,53 @@ def _table(columns: Mapping[str, Any]):
     return out
 
 
-def variables() -> Tuple[List[dict], List[dict]]:
+def variables(modal: bool = True) -> Tuple[List[dict], List[dict]]:
     """The names, dimensions, units and long names of a run's time histories and of the
     coordinates along their dimensions.
 
-    One table in the Rust library (``fretdyn::results::variables``) holds them; the names are
-    the keys of ``results.npz`` and of `Result`, and `Result.to_xarray` and `fretdyn.plot`
-    take their units and labels from it.
+    One table in the Rust library (``fretdyn::results::variables``) holds them: ``results.nc``
+    is written from it, and `Result.to_xarray` and `fretdyn.plot` take their names, units and
+    labels from it, so that ``to_xarray()`` is the Dataset ``xarray.open_dataset`` reads from
+    ``results.nc``.
+
+    Parameters
+    ----------
+    modal : bool, default True
+        The units of ``q`` and ``qdot`` of a modal model (``kg^0.5 m``, mass-normalised
+        modes); False: of a model in physical coordinates (``m``, ``m s-1``).
 
     Returns
     -------
     variables : list of dict
-        One dict per time history (``t``, ``q``, ``qdot``, ``contact_normal_force``, …) with
-        the keys ``name``, ``dims`` (list of dimension names among ``time``, ``contact``,
-        ``mode``, ``direction``), ``units`` (UDUNITS), ``long_name`` and ``flag_meanings``
-        (the meanings of a code's values 0, 1, 2, …; empty otherwise).
+        One dict per time history, in the order of ``results.npz``, with the keys ``key``
+        (of ``results.npz`` and `Result`: ``t``, ``q``, ``qdot``, ``contact_normal_force``,
+        …), ``name`` (in ``results.nc`` and ``to_xarray()``: ``t`` is ``time``, the others
+        keep their key), ``dims`` (among ``time``, ``mode``, ``contact``, ``tangent`` (t1,
+        t2), ``local_axis`` (e1, e2)), ``units`` (UDUNITS, e.g. ``m s-1``), ``long_name``,
+        ``flag_meanings`` (the meanings of a code's values 0, 1, 2, …; empty otherwise) and
+        ``coordinates`` (its auxiliary coordinates).
     coordinates : list of dict
-        The same keys for the coordinates: ``time``, ``contact`` (names), ``point`` (the
-        structure point of each contact), ``mode`` (from 1), ``frequency`` (Hz),
-        ``direction``.
+        The keys ``name``, ``dims``, ``units`` (None for names), ``long_name`` and
+        ``flag_meanings`` of the coordinates besides ``time``: ``mode`` (numbers from 1) with
+        ``frequency`` (Hz) and ``damping_ratio``; ``contact`` (names) with
+        ``contact_point`` and ``contact_obstacle``; ``tangent``, ``local_axis``; ``point``
+        (names) with ``point_position`` (m, along ``direction``: x, y, z).
 
     Examples
     --------
     >>> names, coords = fretdyn.variables()
-    >>> {v["name"]: v["units"] for v in names}["contact_normal_force"]
-    'N'
+    >>> {v["key"]: v["units"] for v in names}["contact_slip_velocity"]
+    'm s-1'
     """
-    return _native.variables()
+    return _native.variables(modal)
 
 
 def _units() -> dict:
-    """name → the dict of `variables` for every variable and coordinate."""
+    """key or name → the dict of `variables` for every time history and coordinate."""
     names, coords = _native.variables()
-    return {v["name"]: v for v in [*names, *coords]}
+    table = {v["name"]: v for v in [*names, *coords]}
+    table.update({v["key"]: v for v in names})
+    return table
 
 
 class Case:
@@ -457,7 +471,7 @@ class Result(Mapping):
 
     @property
     def qdot(self) -> np.ndarray:
-        """Modal velocities (full step), kg^0.5 m/s, shape (N, modes)."""
+        """Modal velocities (full step), kg^0.5 m s-1, shape (N, modes)."""
         return self._arrays["qdot"]
 
     @property
@@ -473,8 +487,8 @@ class Result(Mapping):
 
     @property
     def contact_slip_velocity(self) -> np.ndarray:
-        """Tangential velocity relative to the obstacle (full step), tangent basis, m/s,
-        shape (N, contacts, 2)."""
+        """Tangential velocity relative to the obstacle (full step), tangent basis (t1, t2),
+        m s-1, shape (N, contacts, 2)."""
         return self._arrays["contact_slip_velocity"]
 
     @property
@@ -489,9 +503,10 @@ class Result(Mapping):
 
     @property
     def contact_position(self) -> np.ndarray:
-        """The point relative to the obstacle, m, shape (N, contacts, 2): in a hole, its
-        offset from the hole's centre in the hole's axes (the orbit); for a plane or bars,
-        the distance from the plane and the position along t1."""
+        """The point relative to the obstacle, m, shape (N, contacts, 2), along the
+        obstacle's axes (e1, e2): in a hole, its offset from the hole's centre in the hole's
+        axes (the orbit); for a plane or bars, the distance from the plane (e1) and the
+        position along t1 (e2)."""
         return self._arrays["contact_position"]
 
     @property
@@ -550,15 +565,21 @@ class Result(Mapping):
         return _table(columns)
 
     def to_xarray(self):
-        """The time histories as an xarray Dataset with names and units.
+        """The time histories as an xarray Dataset with names and units: the Dataset
+        ``xarray.open_dataset`` reads from the ``results.nc`` of ``fretdyn run``.
 
-        Dimensions ``time``, ``contact``, ``mode``, ``direction``; coordinates ``time`` (s),
-        ``contact`` (names), ``point`` (the structure point of each contact), ``mode`` (from
-        1), ``frequency`` (Hz), ``direction`` (1, 2); every variable and coordinate has
-        ``units`` and ``long_name`` attributes (`variables`); ``contact_status`` has CF
-        ``flag_values`` and ``flag_meanings``. The Dataset's attributes are ``title``,
-        ``fretdyn_version`` and ``summary`` (the summary as JSON text, the case included), so
-        that ``to_netcdf`` writes it.
+        The same variables, dimensions, coordinates and attributes, from the one table of
+        `variables`: dimensions ``time``, ``mode``, ``contact``, ``tangent`` (t1, t2),
+        ``local_axis`` (e1, e2), ``point``, ``direction`` (x, y, z); coordinates ``time``
+        (s; the key ``t``), ``mode`` (numbers from 1) with ``frequency`` (Hz) and
+        ``damping_ratio``, ``contact`` (names) with ``contact_point`` and
+        ``contact_obstacle``, ``point`` (names) with ``point_position`` (m), and the labels
+        of ``tangent``, ``local_axis`` and ``direction``; every other array under its key.
+        Every variable has ``units`` (UDUNITS; names have none) and ``long_name``;
+        ``contact_status`` has CF ``flag_values`` and ``flag_meanings``. The Dataset's
+        attributes are ``title``, ``fretdyn_version``, ``comment`` and ``summary`` (the
+        summary as JSON text, the case included; ``results.nc`` has the case file's text as
+        ``case`` too), so that ``to_netcdf`` writes it.
 
         Returns
         -------
@@ -572,9 +593,9 @@ class Result(Mapping):
         Examples
         --------
         >>> ds = r.to_xarray()
-        >>> ds.contact_normal_force.sel(contact="plane").max().item()
-        >>> ds.contact_normal_force.attrs["units"]
-        'N'
+        >>> ds.contact_normal_force.sel(contact="plate3").max().item()
+        >>> ds.contact_slip_velocity.sel(tangent="t1").attrs["units"]
+        'm s-1'
         """
         try:
             import xarray as xr
@@ -582,38 +603,37 @@ class Result(Mapping):
             raise ImportError(
                 "Result.to_xarray needs xarray: pip install xarray (or fretdyn[xarray])"
             ) from e
-        names, coords_table = _native.variables()
-        attrs = {v["name"]: {"units": v["units"], "long_name": v["long_name"]}
-                 for v in [*names, *coords_table]}
-        for a in attrs.values():
-            if not a["units"]:
-                del a["units"]
-        values = {
-            "time": self.t,
-            "contact": np.array(self.contact_names, dtype=str),
-            "point": np.array(self._case.contact_points, dtype=str),
-            "mode": np.arange(1, self.q.shape[1] + 1),
-            "frequency": self._case.frequencies_hz,
-            "direction": np.array([1, 2]),
-        }
-        coords = {
-            v["name"]: (v["dims"], values[v["name"]], attrs[v["name"]]) for v in coords_table
-        }
-        data = {}
-        for v in names:
-            if v["name"] == "t":
-                continue
-            a = dict(attrs[v["name"]])
+        values, modal = _native.coordinates(self._case._native)
+        names, coords_table = _native.variables(modal)
+
+        def attrs(v: dict) -> dict:
+            a = {} if v["units"] is None else {"units": v["units"]}
+            a["long_name"] = v["long_name"]
             if v["flag_meanings"]:
                 a["flag_values"] = np.arange(len(v["flag_meanings"]), dtype=np.int8)
                 a["flag_meanings"] = " ".join(v["flag_meanings"])
-            data[v["name"]] = (v["dims"], self._arrays[v["name"]], a)
+            return a
+
+        coords = {}
+        for v in coords_table:
+            x = values[v["name"]]
+            if isinstance(x, list):  # names
+                x = np.array(x, dtype=str)
+            coords[v["name"]] = (v["dims"], x, attrs(v))
+        data = {}
+        for v in names:
+            entry = (v["dims"], self._arrays[v["key"]], attrs(v))
+            if v["name"] in v["dims"]:  # t: the coordinate time
+                coords[v["name"]] = entry
+            else:
+                data[v["name"]] = entry
         return xr.Dataset(
             data,
             coords=coords,
             attrs={
-                "title": self._summary.get("title", ""),
+                "title": self._summary.get("title", self._case.title),
                 "fretdyn_version": self._summary.get("fretdyn_version", __version__),
+                "comment": _native.RESULTS_COMMENT,
                 "summary": json.dumps(self._summary),
             },
         )

@@ -42,9 +42,19 @@ def _axes(ax: Any):
 
 
 def _units(name: str) -> str:
+    """The units of a time history or coordinate (by its key or name) in `fretdyn.variables`."""
     from . import _units as table
 
     return table()[name]["units"]
+
+
+def _labels(result: Any, dim: str) -> List[str]:
+    """The labels along a dimension of the results (``local_axis``: e1, e2; ``tangent``: t1,
+    t2), as ``to_xarray()`` and ``results.nc`` have them."""
+    from . import _native
+
+    values, _ = _native.coordinates(result.case._native)
+    return list(values[dim])
 
 
 def _select(result: Any, contact: Contacts, default: Optional[List[int]] = None) -> List[int]:
@@ -88,8 +98,9 @@ def orbits(result: Any, contact: Contacts = None, ax: Any = None):
     Returns
     -------
     matplotlib.axes.Axes
-        Its lines are, for each contact in turn, the orbit (x: component 1 of
-        ``contact_position``, y: component 2), then the outline of a hole.
+        Its lines are, for each contact in turn, the orbit (x: ``contact_position`` along
+        e1, y: along e2, the ``local_axis`` of ``to_xarray()``), then the outline of a
+        hole.
 
     Examples
     --------
@@ -110,18 +121,19 @@ def orbits(result: Any, contact: Contacts = None, ax: Any = None):
             ax.plot(o[:, 0], o[:, 1], "--", lw=1.0, color=line.get_color(),
                     label=f"{result.contact_names[k]}: hole")
     units = _units("contact_position")
+    e1, e2 = _labels(result, "local_axis")
     in_holes = all(geometry[k].get("outline") for k in chosen)
     on_planes = not any(geometry[k].get("outline") for k in chosen)
     if in_holes:
-        ax.set_xlabel(f"e1, offset from the hole's centre ({units})")
-        ax.set_ylabel(f"e2, offset from the hole's centre ({units})")
+        ax.set_xlabel(f"{e1}, offset from the hole's centre ({units})")
+        ax.set_ylabel(f"{e2}, offset from the hole's centre ({units})")
         ax.set_aspect("equal", adjustable="datalim")
     elif on_planes:
-        ax.set_xlabel(f"distance from the plane ({units})")
-        ax.set_ylabel(f"position along t1 ({units})")
+        ax.set_xlabel(f"{e1}, distance from the plane ({units})")
+        ax.set_ylabel(f"{e2}, position along t1 ({units})")
     else:
-        ax.set_xlabel(f"contact_position, component 1 ({units})")
-        ax.set_ylabel(f"contact_position, component 2 ({units})")
+        ax.set_xlabel(f"contact_position, {e1} ({units})")
+        ax.set_ylabel(f"contact_position, {e2} ({units})")
     ax.set_title(f"{result.case.title}: orbits")
     ax.legend(fontsize="small")
     return ax

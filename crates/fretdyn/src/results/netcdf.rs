@@ -1,20 +1,21 @@
 //! `results.nc`: the time histories of `results.npz` in a self-describing netCDF-4/HDF5 file
 //! (THEORY §5), which `xarray.open_dataset`, `ncdump -h` or HDFView read without the README:
 //!
-//! - dimensions `time` (unlimited), `mode`, `contact`, `tangent` (t1, t2: the contact's tangent
-//!   basis), `local_axis` (e1, e2: the obstacle's axes of `contact_position`), `point` and
-//!   `direction` (x, y, z);
-//! - coordinates: `time` (the `t` of `results.npz`), `mode` (numbers from 1, with
-//!   `frequency` and `damping_ratio`), `contact` (the contacts' names, with `contact_point`
-//!   and `contact_obstacle`), `point` (the structure points' names), and the labels of
-//!   `tangent`, `local_axis` and `direction`;
+//! - the dimensions, variables and coordinates of the one table
+//!   [`crate::results::variables`], with its names, `units` (UDUNITS) and `long_name` (CF
+//!   `flag_values`/`flag_meanings` for `contact_status`), and nothing of its own: `time`
+//!   (unlimited; the `t` of `results.npz`), `mode`, `contact`, `tangent` (t1, t2),
+//!   `local_axis` (e1, e2), `point`, `direction` (x, y, z); the auxiliary coordinates in the
+//!   CF `coordinates` attribute of the variables along their dimensions, `point_position` in
+//!   the global one (xarray's convention);
 //! - every other key of `results.npz` under its own name, with the same numbers (bit for
 //!   bit) and shapes, the sample first (`time`);
-//! - `units` (SI, UDUNITS spelling) and `long_name` on every numeric variable, `long_name` on
-//!   the name labels (names have no unit);
-//! - global attributes: `title`, `fretdyn_version`, `case` (the text of the case file) and
-//!   `summary` (the text of `summary.json`) when the front end gives them
+//! - global attributes: `title`, `fretdyn_version`, `comment`, `case` (the text of the case
+//!   file) and `summary` (the text of `summary.json`) when the front end gives them
 //!   ([`ResultsMetadata`]).
+//!
+//! The Python package's `Result.to_xarray()` builds the Dataset that `xarray.open_dataset`
+//! reads from this file, from the same table.
 //!
 //! # When it is written, and why then
 //!
@@ -47,8 +48,11 @@ use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
-use crate::model::{Coordinates, Model};
 use crate::results::stream::{Dtype, NPY_HEADER, ResultsMetadata};
+use crate::results::variables::{self, COORDINATES, TIME, Values, Variable};
+
+/// The names and reference values that label the arrays (see [`variables::Labels`]).
+pub use crate::results::variables::Labels;
 
 /// The file name in a run folder.
 pub use crate::results::stream::NETCDF_FILE;
@@ -59,57 +63,6 @@ pub const READ_BYTES: usize = 4 << 20;
 /// Bytes of an HDF5 chunk along `time` (at most; fewer for a short run).
 const CHUNK_BYTES: usize = 1 << 20;
 
-/// The names and reference values of a model that label the arrays of `results.nc`: its
-/// contacts, points and modes (a few per contact, point or mode; kept by a streamed run for
-/// its packing).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Labels {
-    contacts: Vec<String>,
-    contact_points: Vec<String>,
-    contact_obstacles: Vec<&'static str>,
-    points: Vec<String>,
-    /// Reference positions, row-major (point, direction), m.
-    point_positions: Vec<f64>,
-    /// `ω_i / 2π`, Hz.
-    frequencies_hz: Vec<f64>,
-    damping_ratios: Vec<f64>,
-    /// `q` are modal coordinates (else physical ones, in m).
-    modal: bool,
-}
-
-impl Labels {
-    /// The labels of `model`'s results.
-    pub fn of(model: &Model) -> Self {
-        let b = &model.basis;
-        Self {
-            contacts: model.contacts.iter().map(|c| c.name.clone()).collect(),
-            contact_points: model
-                .contacts
-                .iter()
-                .map(|c| {
-                    b.points
-                        .get(c.point)
-                        .map_or_else(String::new, |p| p.name.clone())
-                })
-                .collect(),
-            contact_obstacles: model.contacts.iter().map(|c| c.obstacle.kind()).collect(),
-            points: b.points.iter().map(|p| p.name.clone()).collect(),
-            point_positions: b
-                .points
-                .iter()
-                .flat_map(|p| [p.coords.x, p.coords.y, p.coords.z])
-                .collect(),
-            frequencies_hz: b
-                .omega
-                .iter()
-                .map(|w| w / (2.0 * std::f64::consts::PI))
-                .collect(),
-            damping_ratios: b.damping_ratio.clone(),
-            modal: matches!(model.coordinates, Coordinates::Modal),
-        }
-    }
-}
-
 /// One streamed series (`series/<key>.npy`, written by [`crate::results::stream`]): a
 /// fixed [`NPY_HEADER`]-byte header, then `rows` rows of `row_shape` little-endian values.
 pub(crate) struct SeriesFile<'a> {
@@ -118,94 +71,6 @@ pub(crate) struct SeriesFile<'a> {
     pub dtype: Dtype,
     pub row_shape: &'a [usize],
     pub rows: u64,
-}
-
-/// What `results.nc` calls a key of `results.npz`: name, dimensions, units, long name.
-struct Described {
-    name: &'static str,
-    dims: &'static [&'static str],
-    units: &'static str,
-    long_name: &'static str,
-}
-
-/// The description of the series `key` (README "Reading the results"); `None` for a key
-/// this module does not know (a new series must be described here: the tests check that
-/// every key of `results.npz` is in `results.nc`).
-fn describe(key: &str, modal: bool) -> Option<Described> {
-    let d = |name, dims, units, long_name| {
-        Some(Described {
-            name,
-            dims,
-            units,
-            long_name,
-        })
-    };
-    const TC: &[&str] = &["time", "contact"];
-    const TCT: &[&str] = &["time", "contact", "tangent"];
-    match key {
-        "t" => d("time", &["time"], "s", "time"),
-        "q" if modal => d(
-            "q",
-            &["time", "mode"],
-            "kg^0.5 m",
-            "modal displacement (mass-normalised modes: displacement = mode shape × q)",
-        ),
-        "q" => d(
-            "q",
-            &["time", "mode"],
-            "m",
-            "displacement (physical coordinates)",
-        ),
-        "qdot" if modal => d(
-            "qdot",
-            &["time", "mode"],
-            "kg^0.5 m/s",
-            "modal velocity (full step)",
-        ),
-        "qdot" => d(
-            "qdot",
-            &["time", "mode"],
-            "m/s",
-            "velocity (physical coordinates, full step)",
-        ),
-        "contact_normal_force" => d(
-            "contact_normal_force",
-            TC,
-            "N",
-            "normal contact force magnitude R_N (>= 0)",
-        ),
-        "contact_tangential_force" => d(
-            "contact_tangential_force",
-            TCT,
-            "N",
-            "tangential force of the obstacle on the structure, in the contact's tangent basis (t1, t2)",
-        ),
-        "contact_slip_velocity" => d(
-            "contact_slip_velocity",
-            TCT,
-            "m/s",
-            "tangential velocity relative to the obstacle (full step), in the contact's tangent basis (t1, t2)",
-        ),
-        "contact_penetration" => d(
-            "contact_penetration",
-            TC,
-            "m",
-            "penetration (negative: the remaining clearance)",
-        ),
-        "contact_status" => d(
-            "contact_status",
-            TC,
-            "1",
-            "contact status: 0 open, 1 stick, 2 slip",
-        ),
-        "contact_position" => d(
-            "contact_position",
-            &["time", "contact", "local_axis"],
-            "m",
-            "the point relative to the obstacle: in a hole, the tube centre's offset from the hole's centre in the hole's axes (e1, e2); for a plane or bars, the distance from the plane (e1) and the position along t1 (e2)",
-        ),
-        _ => None,
-    }
 }
 
 /// Writes `results.nc` in `dir` from the streamed `series`, labelled by `labels`, with the
@@ -250,129 +115,47 @@ fn write_to(
     }
     file.add_attribute("fretdyn_version", env!("CARGO_PKG_VERSION"))
         .map_err(nc)?;
-    file.add_attribute(
-        "comment",
-        "the arrays of results.npz under their keys, t as the coordinate time (README, \"Reading the results\")",
-    )
-    .map_err(nc)?;
+    file.add_attribute("comment", variables::COMMENT)
+        .map_err(nc)?;
     for (name, text) in [("case", &meta.case_toml), ("summary", &meta.summary_json)] {
         if let Some(text) = text {
             file.add_attribute(name, vec![text.clone()]).map_err(nc)?;
         }
     }
-
-    // dimensions (a length 0, e.g. no contact, is an unlimited dimension in netCDF-4: the
-    // arrays still have length 0 along it)
-    let (p, c, n) = (
-        labels.frequencies_hz.len(),
-        labels.contacts.len(),
-        labels.points.len(),
-    );
-    file.add_unlimited_dimension("time").map_err(nc)?;
-    for (name, len) in [
-        ("mode", p),
-        ("contact", c),
-        ("tangent", 2),
-        ("local_axis", 2),
-        ("point", n),
-        ("direction", 3),
-    ] {
-        file.add_dimension(name, len).map_err(nc)?;
+    let global = variables::global_coordinates();
+    if !global.is_empty() {
+        file.add_attribute("coordinates", global.join(" "))
+            .map_err(nc)?;
     }
 
-    // coordinates and labels
-    let numbers: Vec<i32> = (1..=p as i32).collect();
-    numeric(
-        &mut file,
-        "mode",
-        &["mode"],
-        "1",
-        "mode number, from 1, in the order of the modal basis",
-        &numbers,
-    )?;
-    numeric(
-        &mut file,
-        "frequency",
-        &["mode"],
-        "Hz",
-        "natural frequency of the mode (undamped, without contact)",
-        &labels.frequencies_hz,
-    )?;
-    numeric(
-        &mut file,
-        "damping_ratio",
-        &["mode"],
-        "1",
-        "modal damping ratio",
-        &labels.damping_ratios,
-    )?;
-    strings(
-        &mut file,
-        "contact",
-        "contact",
-        "contact name",
-        &labels.contacts,
-    )?;
-    strings(
-        &mut file,
-        "contact_point",
-        "contact",
-        "the structure point of the contact",
-        &labels.contact_points,
-    )?;
-    let obstacles: Vec<String> = labels
-        .contact_obstacles
-        .iter()
-        .map(|k| k.to_string())
-        .collect();
-    strings(
-        &mut file,
-        "contact_obstacle",
-        "contact",
-        "obstacle type (plane, circle, bi_plane, polygon)",
-        &obstacles,
-    )?;
-    strings(
-        &mut file,
-        "tangent",
-        "tangent",
-        "direction of the contact's tangent basis",
-        &["t1".into(), "t2".into()],
-    )?;
-    strings(
-        &mut file,
-        "local_axis",
-        "local_axis",
-        "axis of the obstacle's local frame (contact_position)",
-        &["e1".into(), "e2".into()],
-    )?;
-    strings(
-        &mut file,
-        "point",
-        "point",
-        "structure point name",
-        &labels.points,
-    )?;
-    strings(
-        &mut file,
-        "direction",
-        "direction",
-        "axis of the global frame",
-        &["x".into(), "y".into(), "z".into()],
-    )?;
-    numeric(
-        &mut file,
-        "point_position",
-        &["point", "direction"],
-        "m",
-        "reference (undeformed) position of the point",
-        &labels.point_positions,
-    )?;
+    // dimensions, in the order of their coordinates (a length 0, e.g. no contact, is an
+    // unlimited dimension in netCDF-4: the arrays still have length 0 along it)
+    file.add_unlimited_dimension(TIME).map_err(nc)?;
+    for c in &COORDINATES {
+        let name = c.variable.name;
+        if c.variable.dims == [name] {
+            let len = labels.dimension_len(name).ok_or_else(|| {
+                std::io::Error::other(format!("dimension '{name}' has no length"))
+            })?;
+            file.add_dimension(name, len).map_err(nc)?;
+        }
+    }
+
+    // coordinates
+    for c in &COORDINATES {
+        let v = &c.variable;
+        match labels.values(c.source) {
+            Values::Text(names) => strings(&mut file, v, &names)?,
+            Values::Int(numbers) => numeric(&mut file, v, &numbers)?,
+            Values::Float(numbers) => numeric(&mut file, v, &numbers)?,
+        }
+    }
 
     // the time histories, streamed from series/
+    let table = variables::time_histories(labels.modal());
     let rows = series.first().map_or(0, |s| s.rows) as usize;
     for s in series {
-        let Some(d) = describe(s.key, labels.modal) else {
+        let Some(d) = table.iter().find(|h| h.key == s.key).map(|h| &h.variable) else {
             return Err(std::io::Error::other(format!(
                 "series '{}' has no description for results.nc",
                 s.key
@@ -391,23 +174,22 @@ fn write_to(
         let mut chunking = vec![chunk_rows];
         chunking.extend(s.row_shape.iter().map(|&l| l.max(1)));
         v.set_chunking(&chunking).map_err(nc)?;
-        v.put_attribute("units", d.units).map_err(nc)?;
-        v.put_attribute("long_name", d.long_name).map_err(nc)?;
-        match s.key {
-            "q" | "qdot" => {
-                v.put_attribute("coordinates", "frequency damping_ratio")
-                    .map_err(nc)?;
+        describe(&mut v, d)?;
+        if !d.flag_meanings.is_empty() {
+            let n = d.flag_meanings.len() as i8;
+            match s.dtype {
+                Dtype::I8 => v.put_attribute("flag_values", (0..n).collect::<Vec<i8>>()),
+                Dtype::F64 => {
+                    v.put_attribute("flag_values", (0..n).map(f64::from).collect::<Vec<f64>>())
+                }
             }
-            "contact_status" => {
-                v.put_attribute("flag_values", vec![0i8, 1, 2])
-                    .map_err(nc)?;
-                v.put_attribute("flag_meanings", "open stick slip")
-                    .map_err(nc)?;
-            }
-            _ => {}
+            .map_err(nc)?;
+            v.put_attribute("flag_meanings", d.flag_meanings.join(" "))
+                .map_err(nc)?;
         }
-        if s.key.starts_with("contact_") {
-            v.put_attribute("coordinates", "contact_point contact_obstacle")
+        let auxiliary = variables::auxiliary_coordinates(d.dims);
+        if !auxiliary.is_empty() {
+            v.put_attribute("coordinates", auxiliary.join(" "))
                 .map_err(nc)?;
         }
         if row_len == 0 || s.rows == 0 {
@@ -449,36 +231,103 @@ fn write_to(
     file.close().map_err(nc)
 }
 
-/// A numeric variable written whole, with its units and long name.
+/// The `units` (numbers only) and `long_name` of the table on `v`.
+fn describe(v: &mut ::netcdf::VariableMut, d: &Variable) -> std::io::Result<()> {
+    if let Some(units) = d.units {
+        v.put_attribute("units", units).map_err(nc)?;
+    }
+    v.put_attribute("long_name", d.long_name).map_err(nc)?;
+    Ok(())
+}
+
+/// A numeric coordinate written whole.
 fn numeric<T: ::netcdf::NcTypeDescriptor>(
     file: &mut ::netcdf::FileMut,
-    name: &str,
-    dims: &[&str],
-    units: &str,
-    long_name: &str,
+    d: &Variable,
     values: &[T],
 ) -> std::io::Result<()> {
-    let mut v = file.add_variable::<T>(name, dims).map_err(nc)?;
-    v.put_attribute("units", units).map_err(nc)?;
-    v.put_attribute("long_name", long_name).map_err(nc)?;
+    let mut v = file.add_variable::<T>(d.name, d.dims).map_err(nc)?;
+    describe(&mut v, d)?;
     if !values.is_empty() {
         v.put_values(values, ..).map_err(nc)?;
     }
     Ok(())
 }
 
-/// A variable of names along `dim`, with its long name.
-fn strings(
-    file: &mut ::netcdf::FileMut,
-    name: &str,
-    dim: &str,
-    long_name: &str,
-    values: &[String],
-) -> std::io::Result<()> {
-    let mut v = file.add_string_variable(name, &[dim]).map_err(nc)?;
-    v.put_attribute("long_name", long_name).map_err(nc)?;
+/// A coordinate of names.
+fn strings(file: &mut ::netcdf::FileMut, d: &Variable, values: &[String]) -> std::io::Result<()> {
+    let mut v = file.add_string_variable(d.name, d.dims).map_err(nc)?;
+    describe(&mut v, d)?;
     for (i, s) in values.iter().enumerate() {
         v.put_string(s, [i]).map_err(nc)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use std::ops::ControlFlow;
+
+    use nalgebra::DMatrix;
+
+    use crate::model::{Coordinates, PhysicalMatrices};
+    use crate::results::stream::{self, ProgressOnly, StreamSettings};
+
+    /// The units of `q` and `q̇` follow the model's coordinates: the V1a point mass (1 kg, so
+    /// `Φ = I`) run in modal coordinates, then in physical ones (`M = I`, `C = K = 0`: the
+    /// same motion), gives `q` in `kg^0.5 m` then in m, each with the other attributes of
+    /// the table.
+    #[test]
+    fn q_has_the_units_of_the_models_coordinates() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples/v1a_oblique_impact.toml");
+        let case = crate::case::Case::from_file(&path).unwrap();
+        let mut physical = case.model.clone();
+        physical.coordinates = Coordinates::Physical(Box::new(PhysicalMatrices {
+            mass: DMatrix::identity(3, 3),
+            damping: DMatrix::zeros(3, 3),
+            stiffness: DMatrix::zeros(3, 3),
+        }));
+        let dir = std::env::temp_dir().join(format!("fretdyn-nc-units-{}", std::process::id()));
+        let mut q_values = Vec::new();
+        for (model, q, qdot) in [
+            (&case.model, "kg^0.5 m", "kg^0.5 m s-1"),
+            (&physical, "m", "m s-1"),
+        ] {
+            let _ = std::fs::remove_dir_all(&dir);
+            stream::run(
+                model,
+                &case.settings,
+                &dir,
+                &StreamSettings::default(),
+                0,
+                &mut ProgressOnly(|_| ControlFlow::Continue(())),
+            )
+            .unwrap();
+            let file = ::netcdf::open(dir.join(super::NETCDF_FILE)).unwrap();
+            let text = |var: &str, attr: &str| -> String {
+                let v = file.variable(var).unwrap();
+                let value = v.attribute_value(attr).unwrap().unwrap();
+                String::try_from(value).unwrap()
+            };
+            assert_eq!(text("q", "units"), q);
+            assert_eq!(text("qdot", "units"), qdot);
+            for key in ["q", "qdot"] {
+                assert_eq!(text(key, "coordinates"), "frequency damping_ratio");
+            }
+            assert_eq!(text("contact_slip_velocity", "units"), "m s-1");
+            let v = file.variable("q").unwrap();
+            q_values.push(v.get_values::<f64, _>(..).unwrap());
+            drop(file);
+            std::fs::remove_dir_all(&dir).unwrap();
+        }
+        // the same motion (the two solvers round alike or nearly)
+        let (a, b) = (&q_values[0], &q_values[1]);
+        assert_eq!(a.len(), b.len());
+        let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(scale > 0.0);
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-9 * scale, "{x} {y}");
+        }
+    }
 }

@@ -402,7 +402,7 @@ struct Files {
     model_contacts: Vec<String>,
     /// The names and units of `results.nc`.
     #[cfg(feature = "netcdf")]
-    labels: crate::results::netcdf::Labels,
+    labels: crate::results::variables::Labels,
 }
 
 impl Files {
@@ -433,7 +433,7 @@ impl Files {
             blocks,
             model_contacts: model.contacts.iter().map(|c| c.name.clone()).collect(),
             #[cfg(feature = "netcdf")]
-            labels: crate::results::netcdf::Labels::of(model),
+            labels: crate::results::variables::Labels::of(model),
         };
         files.sync()?;
         Ok(files)
@@ -465,7 +465,7 @@ impl Files {
             blocks: reopen_at(&dir.join(BLOCKS_FILE), blocks_bytes)?,
             model_contacts: model.contacts.iter().map(|c| c.name.clone()).collect(),
             #[cfg(feature = "netcdf")]
-            labels: crate::results::netcdf::Labels::of(model),
+            labels: crate::results::variables::Labels::of(model),
         })
     }
 

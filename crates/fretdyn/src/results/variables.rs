@@ -1,39 +1,108 @@
-//! Names, dimensions, units and long names of the time histories of a run (the keys of
-//! `results.npz`, THEORY §5), and of the coordinates along their dimensions: the one table
-//! that self-describing outputs (`results.nc`, the Python package's `Result.to_xarray()`)
-//! and plot labels take their metadata from. Units are UDUNITS strings (`m s-1`); the modal
-//! coordinates of mass-normalised modes are in `kg^0.5 m` (`Φᵀ M Φ = I`, THEORY §1).
+//! The one table of names, dimensions, units and long names of a run's time histories (the
+//! keys of `results.npz`, THEORY §5) and of the coordinates along their dimensions. Every
+//! self-describing output takes its metadata from here, and nowhere else: `results.nc`
+//! ([`crate::results::netcdf`]), the Python package's `Result.to_xarray()` and its plot labels
+//! (`fretdyn.variables()`). `xarray.open_dataset("results.nc")` and `to_xarray()` are then the
+//! same Dataset.
+//!
+//! - dimensions: [`TIME`], [`MODE`], [`CONTACT`], [`TANGENT`] (t1, t2: the contact's tangent
+//!   basis), [`LOCAL_AXIS`] (e1, e2: the obstacle's axes of `contact_position`), [`POINT`]
+//!   and [`DIRECTION`] (x, y, z: the global frame);
+//! - the time histories ([`time_histories`]): the key `t` is the coordinate `time`, every
+//!   other key keeps its name;
+//! - the coordinates ([`COORDINATES`]): `mode` (numbers from 1) with `frequency` and
+//!   `damping_ratio`; `contact` (names) with `contact_point` and `contact_obstacle`; `point`
+//!   (names) with `point_position`; the labels of `tangent`, `local_axis` and `direction`.
+//!   Their values come from the model ([`Labels`]).
+//!
+//! Units are UDUNITS strings, products by a space and powers by a number (`m s-1`,
+//! `kg^0.5 m`); `1` for a dimensionless number or a code; names have none. The modal
+//! coordinates of mass-normalised modes are in `kg^0.5 m` (`Φᵀ M Φ = I`, THEORY §1): the
+//! displacement is the mode shape (m kg^-0.5) times `q`. A model in physical coordinates
+//! ([`crate::model::Coordinates::Physical`]) has `q` in m and `q̇` in `m s-1`.
 
-/// Dimension of the samples (`[output] every` decimates).
+use crate::model::{Coordinates, Model};
+
+/// Dimension of the samples (`[output] every` decimates); unlimited in `results.nc`.
 pub const TIME: &str = "time";
+/// Dimension of the modes of the basis (of the degrees of freedom in physical coordinates).
+pub const MODE: &str = "mode";
 /// Dimension of the contacts, in the order of the case file.
 pub const CONTACT: &str = "contact";
-/// Dimension of the modes of the basis.
-pub const MODE: &str = "mode";
-/// Dimension of the two components of a tangential vector or of a position relative to the
-/// obstacle (each variable's long name says what they are).
+/// Dimension of the two components of a tangential vector in the contact's tangent basis
+/// (`t1`, `t2`).
+pub const TANGENT: &str = "tangent";
+/// Dimension of the two components of `contact_position` in the obstacle's axes (`e1`,
+/// `e2`).
+pub const LOCAL_AXIS: &str = "local_axis";
+/// Dimension of the structure's named points.
+pub const POINT: &str = "point";
+/// Dimension of the three components of a position in the global frame (`x`, `y`, `z`).
 pub const DIRECTION: &str = "direction";
 
-/// A variable or coordinate: its name, dimensions, units and long name.
+/// A variable or coordinate as `results.nc` and `to_xarray()` name and describe it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Variable {
-    /// Name: the key of `results.npz` for a variable.
+    /// Name in `results.nc` and in `to_xarray()`.
     pub name: &'static str,
     /// Dimensions, in the order of the array's axes.
     pub dims: &'static [&'static str],
-    /// Units (UDUNITS; `1` for a dimensionless number or a code).
-    pub units: &'static str,
+    /// Units (UDUNITS; `1` for a dimensionless number or a code); `None` for names.
+    pub units: Option<&'static str>,
     /// What it is.
     pub long_name: &'static str,
     /// For a code: its values' meanings, in the order of the values 0, 1, 2, … (CF
-    /// `flag_values`/`flag_meanings`); empty otherwise.
+    /// `flag_values`, of the variable's type, and `flag_meanings`, joined by spaces); empty
+    /// otherwise.
     pub flag_meanings: &'static [&'static str],
 }
 
-const fn variable(
+/// A time history of a run: the key of `results.npz` (and of the Python `Result`) and its
+/// description.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TimeHistory {
+    /// Key of `results.npz`.
+    pub key: &'static str,
+    /// Name, dimensions, units, long name.
+    pub variable: Variable,
+}
+
+/// Where the values of a coordinate come from ([`Labels::values`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// `1, 2, …, p` (`i32`).
+    ModeNumbers,
+    /// `ω_i / 2π`, Hz.
+    Frequencies,
+    /// `ξ_i`.
+    DampingRatios,
+    /// The contacts' names.
+    ContactNames,
+    /// The name of each contact's structure point.
+    ContactPoints,
+    /// Each contact's obstacle type ([`crate::contact::obstacle::Obstacle::kind`]).
+    ContactObstacles,
+    /// The points' names.
+    PointNames,
+    /// The points' reference positions, row-major (point, direction), m.
+    PointPositions,
+    /// Fixed labels.
+    Fixed(&'static [&'static str]),
+}
+
+/// A coordinate: its description and where its values come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Coordinate {
+    /// Name, dimensions, units, long name.
+    pub variable: Variable,
+    /// Its values.
+    pub source: Source,
+}
+
+const fn v(
     name: &'static str,
     dims: &'static [&'static str],
-    units: &'static str,
+    units: Option<&'static str>,
     long_name: &'static str,
 ) -> Variable {
     Variable {
@@ -45,85 +114,343 @@ const fn variable(
     }
 }
 
-/// The time histories of a run, in the order of `results.npz`
-/// ([`crate::results::output::write_results_npz`]). `t` is the time coordinate.
-pub const VARIABLES: [Variable; 9] = [
-    variable("t", &[TIME], "s", "time"),
-    variable(
+const fn history(key: &'static str, variable: Variable) -> TimeHistory {
+    TimeHistory { key, variable }
+}
+
+const TC: &[&str] = &[TIME, CONTACT];
+const TCT: &[&str] = &[TIME, CONTACT, TANGENT];
+
+/// The time histories in modal coordinates, in the order of `results.npz`
+/// ([`crate::results::output::write_results_npz`]).
+const MODAL: [TimeHistory; 9] = [
+    history("t", v(TIME, &[TIME], Some("s"), "time")),
+    history(
         "q",
-        &[TIME, MODE],
-        "kg^0.5 m",
-        "modal displacement (mass-normalised modes)",
+        v(
+            "q",
+            &[TIME, MODE],
+            Some("kg^0.5 m"),
+            "modal displacement (mass-normalised modes: displacement = mode shape × q)",
+        ),
     ),
-    variable(
+    history(
         "qdot",
-        &[TIME, MODE],
-        "kg^0.5 m s-1",
-        "modal velocity (full step, mass-normalised modes)",
+        v(
+            "qdot",
+            &[TIME, MODE],
+            Some("kg^0.5 m s-1"),
+            "modal velocity (full step, mass-normalised modes)",
+        ),
     ),
-    variable(
+    history(
         "contact_normal_force",
-        &[TIME, CONTACT],
-        "N",
-        "normal contact force R_N >= 0",
+        v(
+            "contact_normal_force",
+            TC,
+            Some("N"),
+            "normal contact force magnitude R_N (>= 0)",
+        ),
     ),
-    variable(
+    history(
         "contact_tangential_force",
-        &[TIME, CONTACT, DIRECTION],
-        "N",
-        "tangential force of the obstacle on the structure, in the contact's tangent basis (t1, t2)",
+        v(
+            "contact_tangential_force",
+            TCT,
+            Some("N"),
+            "tangential force of the obstacle on the structure, in the contact's tangent basis (t1, t2)",
+        ),
     ),
-    variable(
+    history(
         "contact_slip_velocity",
-        &[TIME, CONTACT, DIRECTION],
-        "m s-1",
-        "tangential velocity relative to the obstacle (full step), in the contact's tangent basis (t1, t2)",
+        v(
+            "contact_slip_velocity",
+            TCT,
+            Some("m s-1"),
+            "tangential velocity relative to the obstacle (full step), in the contact's tangent basis (t1, t2)",
+        ),
     ),
-    variable(
+    history(
         "contact_penetration",
-        &[TIME, CONTACT],
-        "m",
-        "penetration (negative: remaining clearance)",
+        v(
+            "contact_penetration",
+            TC,
+            Some("m"),
+            "penetration (negative: the remaining clearance)",
+        ),
     ),
-    Variable {
-        name: "contact_status",
-        dims: &[TIME, CONTACT],
-        units: "1",
-        long_name: "contact status: 0 open, 1 stick, 2 slip",
-        flag_meanings: &["open", "stick", "slip"],
-    },
-    variable(
+    history(
+        "contact_status",
+        Variable {
+            name: "contact_status",
+            dims: TC,
+            units: Some("1"),
+            long_name: "contact status: 0 open, 1 stick, 2 slip",
+            flag_meanings: &["open", "stick", "slip"],
+        },
+    ),
+    history(
         "contact_position",
-        &[TIME, CONTACT, DIRECTION],
-        "m",
-        "position of the point relative to the obstacle: in a hole, the offset from its centre in the hole's axes (e1, e2); for a plane or bars, the distance from the plane and the position along t1",
+        v(
+            "contact_position",
+            &[TIME, CONTACT, LOCAL_AXIS],
+            Some("m"),
+            "the point relative to the obstacle: in a hole, the tube centre's offset from the hole's centre in the hole's axes (e1, e2); for a plane or bars, the distance from the plane (e1) and the position along t1 (e2)",
+        ),
     ),
 ];
 
-/// The coordinates of the dimensions and what else is known along them: `time` (the samples'
-/// times, `t`), `contact` (the contacts' names), `point` (the structure point of each
-/// contact), `mode` (mode numbers from 1), `frequency` (the modes' natural frequencies),
-/// `direction` (1 and 2, the components).
-pub const COORDINATES: [Variable; 6] = [
-    variable(TIME, &[TIME], "s", "time"),
-    variable(CONTACT, &[CONTACT], "", "contact name"),
-    variable("point", &[CONTACT], "", "structure point of the contact"),
-    variable(MODE, &[MODE], "1", "mode number (from 1)"),
-    variable("frequency", &[MODE], "Hz", "natural frequency of the mode"),
-    variable(
-        DIRECTION,
-        &[DIRECTION],
-        "1",
-        "component (1, 2): see the long name of each variable",
-    ),
+/// `q` and `q̇` of a model in physical coordinates.
+const PHYSICAL_Q: Variable = v(
+    "q",
+    &[TIME, MODE],
+    Some("m"),
+    "displacement (physical coordinates)",
+);
+const PHYSICAL_QDOT: Variable = v(
+    "qdot",
+    &[TIME, MODE],
+    Some("m s-1"),
+    "velocity (physical coordinates, full step)",
+);
+
+/// The time histories of a run, in the order of `results.npz`: of a modal model (`modal`,
+/// `q` in `kg^0.5 m`) or of one in physical coordinates (`q` in m).
+pub fn time_histories(modal: bool) -> [TimeHistory; 9] {
+    let mut out = MODAL;
+    if !modal {
+        for h in &mut out {
+            match h.key {
+                "q" => h.variable = PHYSICAL_Q,
+                "qdot" => h.variable = PHYSICAL_QDOT,
+                _ => {}
+            }
+        }
+    }
+    out
+}
+
+/// The coordinates besides `time` (a time history), in the order `results.nc` writes them.
+/// Those that are not a dimension (`frequency`, `contact_point`, `point_position`, …) are
+/// auxiliary coordinates ([`auxiliary_coordinates`]).
+pub const COORDINATES: [Coordinate; 11] = [
+    Coordinate {
+        variable: v(
+            MODE,
+            &[MODE],
+            Some("1"),
+            "mode number, from 1, in the order of the modal basis",
+        ),
+        source: Source::ModeNumbers,
+    },
+    Coordinate {
+        variable: v(
+            "frequency",
+            &[MODE],
+            Some("Hz"),
+            "natural frequency of the mode (undamped, without contact)",
+        ),
+        source: Source::Frequencies,
+    },
+    Coordinate {
+        variable: v("damping_ratio", &[MODE], Some("1"), "modal damping ratio"),
+        source: Source::DampingRatios,
+    },
+    Coordinate {
+        variable: v(CONTACT, &[CONTACT], None, "contact name"),
+        source: Source::ContactNames,
+    },
+    Coordinate {
+        variable: v(
+            "contact_point",
+            &[CONTACT],
+            None,
+            "the structure point of the contact",
+        ),
+        source: Source::ContactPoints,
+    },
+    Coordinate {
+        variable: v(
+            "contact_obstacle",
+            &[CONTACT],
+            None,
+            "obstacle type (plane, circle, bi_plane, polygon)",
+        ),
+        source: Source::ContactObstacles,
+    },
+    Coordinate {
+        variable: v(
+            TANGENT,
+            &[TANGENT],
+            None,
+            "direction of the contact's tangent basis",
+        ),
+        source: Source::Fixed(&["t1", "t2"]),
+    },
+    Coordinate {
+        variable: v(
+            LOCAL_AXIS,
+            &[LOCAL_AXIS],
+            None,
+            "axis of the obstacle's local frame (contact_position)",
+        ),
+        source: Source::Fixed(&["e1", "e2"]),
+    },
+    Coordinate {
+        variable: v(POINT, &[POINT], None, "structure point name"),
+        source: Source::PointNames,
+    },
+    Coordinate {
+        variable: v(
+            "point_position",
+            &[POINT, DIRECTION],
+            Some("m"),
+            "reference (undeformed) position of the point",
+        ),
+        source: Source::PointPositions,
+    },
+    Coordinate {
+        variable: v(DIRECTION, &[DIRECTION], None, "axis of the global frame"),
+        source: Source::Fixed(&["x", "y", "z"]),
+    },
 ];
 
-/// The variable or coordinate called `name`.
-pub fn find(name: &str) -> Option<&'static Variable> {
-    VARIABLES
+/// The global attribute `comment` of `results.nc` and of `to_xarray()`.
+pub const COMMENT: &str = "the arrays of results.npz under their keys, t as the coordinate time (README, \"Reading the results\")";
+
+/// The auxiliary coordinates (coordinates that are not a dimension) along `dims`' dimensions:
+/// those whose dimensions are all among `dims`. Of a time history, the CF `coordinates`
+/// attribute (`q`: `frequency damping_ratio`; a contact's: `contact_point
+/// contact_obstacle`).
+pub fn auxiliary_coordinates(dims: &[&str]) -> Vec<&'static str> {
+    COORDINATES
         .iter()
-        .chain(&COORDINATES)
+        .map(|c| &c.variable)
+        .filter(|c| c.dims != [c.name] && c.dims.iter().all(|d| dims.contains(d)))
+        .map(|c| c.name)
+        .collect()
+}
+
+/// The auxiliary coordinates along the dimensions of no time history (`point_position`):
+/// xarray reads them as coordinates from the global attribute `coordinates`.
+pub fn global_coordinates() -> Vec<&'static str> {
+    let attached: Vec<&str> = MODAL
+        .iter()
+        .flat_map(|h| auxiliary_coordinates(h.variable.dims))
+        .collect();
+    auxiliary_coordinates(&[MODE, CONTACT, TANGENT, LOCAL_AXIS, POINT, DIRECTION])
+        .into_iter()
+        .filter(|c| !attached.contains(c))
+        .collect()
+}
+
+/// The time history or coordinate called `name` (in `results.nc`; `t` is `time`), of a modal
+/// model.
+pub fn find(name: &str) -> Option<Variable> {
+    MODAL
+        .iter()
+        .map(|h| h.variable)
+        .chain(COORDINATES.iter().map(|c| c.variable))
         .find(|v| v.name == name)
+}
+
+/// The values of a coordinate.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Values {
+    /// Names.
+    Text(Vec<String>),
+    /// Integers (mode numbers).
+    Int(Vec<i32>),
+    /// Numbers, row-major for more than one dimension.
+    Float(Vec<f64>),
+}
+
+/// The names and reference values of a model that label its results: its contacts, points
+/// and modes (a few per contact, point or mode; kept by a streamed run for `results.nc`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Labels {
+    contacts: Vec<String>,
+    contact_points: Vec<String>,
+    contact_obstacles: Vec<&'static str>,
+    points: Vec<String>,
+    /// Reference positions, row-major (point, direction), m.
+    point_positions: Vec<f64>,
+    /// `ω_i / 2π`, Hz.
+    frequencies_hz: Vec<f64>,
+    damping_ratios: Vec<f64>,
+    modal: bool,
+}
+
+impl Labels {
+    /// The labels of `model`'s results.
+    pub fn of(model: &Model) -> Self {
+        let b = &model.basis;
+        Self {
+            contacts: model.contacts.iter().map(|c| c.name.clone()).collect(),
+            contact_points: model
+                .contacts
+                .iter()
+                .map(|c| {
+                    b.points
+                        .get(c.point)
+                        .map_or_else(String::new, |p| p.name.clone())
+                })
+                .collect(),
+            contact_obstacles: model.contacts.iter().map(|c| c.obstacle.kind()).collect(),
+            points: b.points.iter().map(|p| p.name.clone()).collect(),
+            point_positions: b
+                .points
+                .iter()
+                .flat_map(|p| [p.coords.x, p.coords.y, p.coords.z])
+                .collect(),
+            frequencies_hz: b
+                .omega
+                .iter()
+                .map(|w| w / (2.0 * std::f64::consts::PI))
+                .collect(),
+            damping_ratios: b.damping_ratio.clone(),
+            modal: matches!(model.coordinates, Coordinates::Modal),
+        }
+    }
+
+    /// `q` are modal coordinates (else physical ones, in m): the argument of
+    /// [`time_histories`].
+    pub fn modal(&self) -> bool {
+        self.modal
+    }
+
+    /// The length of dimension `dim`; `None` for `time` (the run's samples) and for a name
+    /// that is no dimension.
+    pub fn dimension_len(&self, dim: &str) -> Option<usize> {
+        match dim {
+            MODE => Some(self.frequencies_hz.len()),
+            CONTACT => Some(self.contacts.len()),
+            TANGENT | LOCAL_AXIS => Some(2),
+            POINT => Some(self.points.len()),
+            DIRECTION => Some(3),
+            _ => None,
+        }
+    }
+
+    /// The values of the coordinate whose values come from `source`.
+    pub fn values(&self, source: Source) -> Values {
+        match source {
+            Source::ModeNumbers => Values::Int((1..=self.frequencies_hz.len() as i32).collect()),
+            Source::Frequencies => Values::Float(self.frequencies_hz.clone()),
+            Source::DampingRatios => Values::Float(self.damping_ratios.clone()),
+            Source::ContactNames => Values::Text(self.contacts.clone()),
+            Source::ContactPoints => Values::Text(self.contact_points.clone()),
+            Source::ContactObstacles => Values::Text(
+                self.contact_obstacles
+                    .iter()
+                    .map(|k| k.to_string())
+                    .collect(),
+            ),
+            Source::PointNames => Values::Text(self.points.clone()),
+            Source::PointPositions => Values::Float(self.point_positions.clone()),
+            Source::Fixed(labels) => Values::Text(labels.iter().map(|s| s.to_string()).collect()),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -131,36 +458,147 @@ mod tests {
     use super::*;
     use crate::results::recorder::Recorder;
 
-    /// Every array of the recorder is described, with as many dimensions as it has axes.
+    /// The multi-span tube: 30 modes, 5 contacts in holes, 6 named points.
+    fn tube() -> Model {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples/tube_multispan.toml");
+        crate::case::Case::from_file(&path).unwrap().model
+    }
+
+    const DIMENSIONS: [&str; 7] = [TIME, MODE, CONTACT, TANGENT, LOCAL_AXIS, POINT, DIRECTION];
+
+    /// Every array of the recorder is described, with its dimensions' lengths, and the keys
+    /// are those of `results.npz`.
     #[test]
     fn every_time_history_has_its_dimensions() {
-        let r = Recorder::new(3, 4, 2);
-        let ndims = [
-            r.t.ndim(),
-            r.q.ndim(),
-            r.qdot.ndim(),
-            r.normal_force.ndim(),
-            r.tangential_force.ndim(),
-            r.slip_velocity.ndim(),
-            r.penetration.ndim(),
-            r.status.ndim(),
-            r.position.ndim(),
+        let model = tube();
+        let labels = Labels::of(&model);
+        let (p, c) = (model.basis.modes(), model.contacts.len());
+        assert!(p > 1 && c > 1);
+        let r = Recorder::new(3, p, c);
+        let shapes = [
+            r.t.shape(),
+            r.q.shape(),
+            r.qdot.shape(),
+            r.normal_force.shape(),
+            r.tangential_force.shape(),
+            r.slip_velocity.shape(),
+            r.penetration.shape(),
+            r.status.shape(),
+            r.position.shape(),
         ];
-        for (v, n) in VARIABLES.iter().zip(ndims) {
-            assert_eq!(v.dims.len(), n, "{}", v.name);
-            assert_eq!(v.dims[0], TIME, "{}", v.name);
-            assert!(!v.units.is_empty() && !v.long_name.is_empty(), "{}", v.name);
-        }
-        // the names are the keys of results.npz, each once
-        let mut names: Vec<&str> = VARIABLES.iter().map(|v| v.name).collect();
-        names.sort_unstable();
-        names.dedup();
-        assert_eq!(names.len(), VARIABLES.len());
-        // every dimension has its coordinate
-        for v in &VARIABLES {
-            for d in v.dims {
-                assert!(find(d).is_some_and(|c| c.dims == [*d]), "{d}");
+        // the keys of results.npz (output::write_results_npz, README "Reading the results")
+        let keys = [
+            "t",
+            "q",
+            "qdot",
+            "contact_normal_force",
+            "contact_tangential_force",
+            "contact_slip_velocity",
+            "contact_penetration",
+            "contact_status",
+            "contact_position",
+        ];
+        for modal in [true, false] {
+            let table = time_histories(modal);
+            assert_eq!(table.map(|h| h.key), keys);
+            for (h, shape) in table.iter().zip(shapes) {
+                let v = &h.variable;
+                assert_eq!(v.dims[0], TIME, "{}", v.name);
+                let lens: Vec<usize> = v.dims[1..]
+                    .iter()
+                    .map(|d| labels.dimension_len(d).unwrap())
+                    .collect();
+                assert_eq!(lens, shape[1..], "{}", v.name);
+                assert!(
+                    v.units.is_some_and(|u| !u.is_empty()) && !v.long_name.is_empty(),
+                    "{}",
+                    v.name
+                );
+                assert_eq!(v.name == TIME, h.key == "t");
             }
         }
+        // every dimension has its coordinate, a 1-D variable of its name
+        for d in DIMENSIONS {
+            assert!(find(d).is_some_and(|c| c.dims == [d]), "{d}");
+        }
+        // names are unique
+        let mut names: Vec<&str> = MODAL
+            .iter()
+            .map(|h| h.variable.name)
+            .chain(COORDINATES.iter().map(|c| c.variable.name))
+            .collect();
+        names.sort_unstable();
+        let n = names.len();
+        names.dedup();
+        assert_eq!(names.len(), n);
+    }
+
+    /// Each coordinate's values have the lengths of its dimensions; names have no units,
+    /// numbers have.
+    #[test]
+    fn every_coordinate_has_values_of_its_shape() {
+        let model = tube();
+        let labels = Labels::of(&model);
+        for c in &COORDINATES {
+            let v = &c.variable;
+            let len: usize = v
+                .dims
+                .iter()
+                .map(|d| labels.dimension_len(d).unwrap())
+                .product();
+            let (n, text) = match labels.values(c.source) {
+                Values::Text(s) => (s.len(), true),
+                Values::Int(i) => (i.len(), false),
+                Values::Float(f) => (f.len(), false),
+            };
+            assert_eq!(n, len, "{}", v.name);
+            assert_eq!(v.units.is_none(), text, "{}", v.name);
+            assert!(v.dims.iter().all(|d| DIMENSIONS.contains(d)), "{}", v.name);
+        }
+        let Values::Float(f) = labels.values(Source::Frequencies) else {
+            panic!()
+        };
+        for (f, w) in f.iter().zip(&model.basis.omega) {
+            assert!((f * std::f64::consts::TAU - w).abs() <= 1e-12 * w);
+        }
+    }
+
+    /// Modal coordinates are in kg^0.5 m; physical ones in m (m s-1 for the velocities);
+    /// the other time histories do not change.
+    #[test]
+    fn q_units_follow_the_coordinates() {
+        let units = |modal, key| {
+            time_histories(modal)
+                .iter()
+                .find(|h| h.key == key)
+                .and_then(|h| h.variable.units)
+        };
+        assert_eq!(units(true, "q"), Some("kg^0.5 m"));
+        assert_eq!(units(true, "qdot"), Some("kg^0.5 m s-1"));
+        assert_eq!(units(false, "q"), Some("m"));
+        assert_eq!(units(false, "qdot"), Some("m s-1"));
+        for (a, b) in time_histories(true).iter().zip(time_histories(false)) {
+            if !["q", "qdot"].contains(&a.key) {
+                assert_eq!(*a, b);
+            }
+        }
+    }
+
+    /// The CF `coordinates` of each time history, and `point_position` left for the global
+    /// attribute: every auxiliary coordinate is reachable.
+    #[test]
+    fn auxiliary_coordinates_are_attached() {
+        let of = |key| {
+            let h = MODAL.iter().find(|h| h.key == key).unwrap();
+            auxiliary_coordinates(h.variable.dims)
+        };
+        assert_eq!(of("q"), ["frequency", "damping_ratio"]);
+        assert_eq!(
+            of("contact_position"),
+            ["contact_point", "contact_obstacle"]
+        );
+        assert!(of("t").is_empty());
+        assert_eq!(global_coordinates(), ["point_position"]);
     }
 }
