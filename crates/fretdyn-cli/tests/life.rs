@@ -2,33 +2,8 @@
 //! wear rate, its life.csv against the closed form, scars.csv, life.png, the convergence
 //! runs of `--halvings`; one-line errors naming the file and the field (exit code 2).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn fretdyn(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fretdyn"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("fretdyn runs")
-}
-
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("fretdyn-life-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Self(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+mod common;
+use common::{Scratch, fretdyn};
 
 /// A mass pressed on a bar (10 N) sliding under it at 1 cm/s, μ = 0.3: `W = 0.03 W`.
 const CASE: &str = r#"

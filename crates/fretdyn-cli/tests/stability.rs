@@ -4,34 +4,11 @@
 //! mode is above the critical velocity.
 
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
-fn fretdyn(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fretdyn"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("fretdyn runs")
-}
-
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("fretdyn-stability-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Self(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+mod common;
+use common::{Scratch, fretdyn};
 
 /// A pinned–pinned tube 1 m long along x (modes sin(nπs/L), pairs in y and z), ζ = 0.02, and
 /// one zone over [0.2, 0.7] m at `velocity` (gap) in water-like fluid of 600 kg/m³.
