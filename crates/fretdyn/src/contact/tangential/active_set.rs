@@ -141,7 +141,9 @@ impl ActiveSet {
                     )
                 };
                 if self.stick[k] {
-                    if lambda[k].norm() > slot.s_static * (1.0 + 1e-12) {
+                    // |λ_k| > s_static (1 + 1e-12), compared squared
+                    let bound = slot.s_static * (1.0 + 1e-12);
+                    if lambda[k].norm_squared() > bound * bound {
                         self.stick[k] = false;
                         let (local, _) = local(lambda);
                         let n = local.norm();
@@ -158,9 +160,10 @@ impl ActiveSet {
                         self.stick[k] = true;
                         status_changed = true;
                     } else {
-                        let n = local.norm();
-                        let d = if n > 0.0 {
-                            local / n
+                        // a slip solution has |λ| = s_dynamic (to round-off): its direction
+                        // needs no square root
+                        let d = if slot.s_dynamic > 0.0 {
+                            local / slot.s_dynamic
                         } else {
                             let w = problem.residual_velocity(k, lambda);
                             w / w.norm()
