@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 mod common;
-use common::{Scratch, examples, fretdyn};
+use common::{Scratch, examples, fretdyn, kill_past_checkpoint};
 
 const V1A: &str = include_str!("../../../examples/v1a_oblique_impact.toml");
 
@@ -293,22 +293,7 @@ fn turbulence_tube_killed_at_half_time_resumes_bit_for_bit() {
         .unwrap();
     let killed = s.0.join("killed");
     let start = std::time::Instant::now();
-    while checkpoint_step(&killed).is_none_or(|n| n < 500_000) {
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "the run ended before it could be killed"
-        );
-        assert!(
-            start.elapsed().as_secs() < 600,
-            "no checkpoint past half time"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    Command::new("kill")
-        .args(["-9", &child.id().to_string()])
-        .status()
-        .unwrap();
-    child.wait().unwrap();
+    kill_past_checkpoint(&mut child, &killed, 500_000);
     // readable up to the last flush: every series has the rows its header says
     let t: ndarray::Array1<f64> = ndarray_npy::ReadNpyExt::read_npy(
         std::fs::File::open(killed.join("series/t.npy")).unwrap(),

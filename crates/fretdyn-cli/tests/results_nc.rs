@@ -12,7 +12,7 @@ use std::process::{Command, Output};
 use ndarray_npy::NpzReader;
 
 mod common;
-use common::{Scratch, examples, fretdyn};
+use common::{Scratch, examples, fretdyn, kill_past_checkpoint};
 
 fn assert_ok(out: &Output) {
     assert!(
@@ -424,23 +424,7 @@ fn a_killed_and_resumed_run_has_the_results_nc_of_an_uninterrupted_one() {
         .spawn()
         .unwrap();
     let killed = s.0.join("killed");
-    let start = std::time::Instant::now();
-    while fretdyn::results::stream::checkpoint_step(&killed)
-        .ok()
-        .is_none_or(|n| n < 300_000)
-    {
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "the run ended before it could be killed"
-        );
-        assert!(start.elapsed().as_secs() < 600, "no checkpoint");
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    }
-    Command::new("kill")
-        .args(["-9", &child.id().to_string()])
-        .status()
-        .unwrap();
-    child.wait().unwrap();
+    kill_past_checkpoint(&mut child, &killed, 300_000);
     assert!(!killed.join("results.nc").exists(), "killed mid-run");
     assert_ok(&fretdyn(
         &["run", "--resume", "killed", "-q", "--no-plots"],

@@ -18,6 +18,8 @@ mc = pytest.importorskip(
 )
 from fretdyn import med  # noqa: E402
 
+from helpers import same_bits  # noqa: E402
+
 # A pinned–pinned Euler–Bernoulli beam along x (the tube of examples/beam_three_supports.toml):
 # φ_k(x) = √(2/(ρA L)) sin(kπx/L) in y and in z, f_k = (kπ/L)² √(EI/ρA) / 2π, θz = dφy/dx,
 # θy = −dφz/dx; mass-normalised: ∫ ρA φ_k² dx = 1.
@@ -140,11 +142,6 @@ def npz_of_analytic(path, damping=0.01, rotations=True):
             arrays[f"rotations_{name}"] = np.ascontiguousarray(shapes[:, node, 3:].T)
     np.savez(path, **arrays)
     return path
-
-
-def same_bits(a, b):
-    a, b = np.asarray(a), np.asarray(b)
-    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
 
 
 def case(structure):

@@ -19,8 +19,7 @@ import matplotlib.container  # noqa: E402
 import matplotlib.image  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[3]
-EXAMPLES = ROOT / "examples"
+from helpers import EXAMPLES, ROOT  # noqa: E402,F401
 
 
 @pytest.fixture(scope="module")

@@ -13,22 +13,7 @@ import pytest
 
 import fretdyn
 
-ROOT = Path(__file__).resolve().parents[3]
-EXAMPLES = ROOT / "examples"
-FRETDYN = os.environ.get("FRETDYN", str(ROOT / "target" / "release" / "fretdyn"))
-KEYS = [
-    "t", "q", "qdot", "contact_normal_force", "contact_tangential_force",
-    "contact_slip_velocity", "contact_penetration", "contact_status", "contact_position",
-]
-
-
-def cli(args, cwd):
-    return subprocess.run([FRETDYN, *args], cwd=cwd, capture_output=True, text=True)
-
-
-def same_bits(a, b):
-    a, b = np.asarray(a), np.asarray(b)
-    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+from helpers import EXAMPLES, FRETDYN, KEYS, ROOT, cli, same_bits  # noqa: E402,F401
 
 
 def test_v1a_from_python_equals_the_cli_bit_for_bit(tmp_path):

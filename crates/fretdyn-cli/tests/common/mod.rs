@@ -41,3 +41,28 @@ impl Drop for Scratch {
         let _ = std::fs::remove_dir_all(&self.0);
     }
 }
+
+/// Waits until the streamed run `child` writing into `dir` has a checkpoint at step `step` or
+/// later (it must still be running: a run that ends first fails the test), then `kill -9`s it.
+pub fn kill_past_checkpoint(child: &mut std::process::Child, dir: &Path, step: u64) {
+    let start = std::time::Instant::now();
+    while fretdyn::results::stream::checkpoint_step(dir)
+        .ok()
+        .is_none_or(|n| n < step)
+    {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before it could be killed"
+        );
+        assert!(
+            start.elapsed().as_secs() < 600,
+            "no checkpoint at step {step}"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    Command::new("kill")
+        .args(["-9", &child.id().to_string()])
+        .status()
+        .unwrap();
+    child.wait().unwrap();
+}
