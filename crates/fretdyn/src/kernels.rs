@@ -271,12 +271,11 @@ impl Lanes for Avx2 {
 #[allow(unused_unsafe)]
 mod avx2 {
     use std::arch::x86_64::{
-        __m256d, __m256i, _mm256_add_pd, _mm256_loadu_pd, _mm256_loadu_si256, _mm256_maskload_pd,
-        _mm256_maskstore_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
-        _mm256_sub_pd,
+        __m256d, __m256i, _mm_add_sd, _mm_cvtsd_f64, _mm_hadd_pd, _mm_store_sd, _mm_storeu_pd,
+        _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128, _mm256_extractf128_pd,
+        _mm256_loadu_pd, _mm256_loadu_si256, _mm256_maskload_pd, _mm256_mul_pd, _mm256_set1_pd,
+        _mm256_setzero_pd, _mm256_storeu_pd, _mm256_sub_pd,
     };
-
-    use super::combine;
 
     /// `MASKS[r]`: the first `r` lanes.
     static MASKS: [[i64; 4]; 4] = [[0, 0, 0, 0], [-1, 0, 0, 0], [-1, -1, 0, 0], [-1, -1, -1, 0]];
@@ -298,14 +297,34 @@ mod avx2 {
         unsafe { _mm256_maskload_pd(p, mask) }
     }
 
-    /// The four lanes of `x`.
+    /// `(x₀ + x₁) + (x₂ + x₃)`, [`super::combine`] of the four lanes, in registers: one
+    /// horizontal addition of the two halves, then the sum of its two lanes (a store of the
+    /// vector and four scalar loads would wait on store forwarding).
     #[inline]
     #[target_feature(enable = "avx2")]
-    unsafe fn lanes(x: __m256d) -> [f64; 4] {
-        let mut s = [0.0f64; 4];
-        // SAFETY: `s` holds 4 values
-        unsafe { _mm256_storeu_pd(s.as_mut_ptr(), x) };
-        s
+    unsafe fn sum(x: __m256d) -> f64 {
+        let halves = _mm_hadd_pd(_mm256_castpd256_pd128(x), _mm256_extractf128_pd::<1>(x));
+        _mm_cvtsd_f64(_mm_add_sd(halves, _mm_unpackhi_pd(halves, halves)))
+    }
+
+    /// Stores the first `r < 4` lanes of `x` at `p` (a 128-bit store, a 64-bit one or both:
+    /// a masked 256-bit store is microcoded on some processors).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn store_first(p: *mut f64, r: usize, x: __m256d) {
+        let low = _mm256_castpd256_pd128(x);
+        // SAFETY: the caller's `p..p + r` is inside a slice
+        unsafe {
+            match r {
+                1 => _mm_store_sd(p, low),
+                2 => _mm_storeu_pd(p, low),
+                3 => {
+                    _mm_storeu_pd(p, low);
+                    _mm_store_sd(p.add(2), _mm256_extractf128_pd::<1>(x));
+                }
+                _ => {}
+            }
+        }
     }
 
     /// [`super::Portable::dot`] on AVX2.
@@ -351,7 +370,7 @@ mod avx2 {
                     _mm256_mul_pd(tail(pa.add(full), m), tail(pb.add(full), m)),
                 );
             }
-            combine(lanes(acc))
+            sum(acc)
         }
     }
 
@@ -382,7 +401,7 @@ mod avx2 {
                 s = _mm256_add_pd(s, _mm256_mul_pd(x, tail(pb.add(full), m)));
                 t = _mm256_add_pd(t, _mm256_mul_pd(x, tail(pc.add(full), m)));
             }
-            (combine(lanes(s)), combine(lanes(t)))
+            (sum(s), sum(t))
         }
     }
 
@@ -431,7 +450,7 @@ mod avx2 {
                     s3 = _mm256_add_pd(s3, _mm256_mul_pd(tail(base.add(3 * p + full), m), y));
                 }
                 for (j, acc) in [s0, s1, s2, s3].into_iter().enumerate() {
-                    out[r + j] = combine(lanes(acc));
+                    out[r + j] = sum(acc);
                 }
                 r += 4;
             }
@@ -495,8 +514,8 @@ mod avx2 {
                     tail(v.as_ptr().add(full), m),
                     tail(a.as_ptr().add(full), m),
                 );
-                _mm256_maskstore_pd(q.as_mut_ptr().add(full), m, qn);
-                _mm256_maskstore_pd(vs.as_mut_ptr().add(full), m, vn);
+                store_first(q.as_mut_ptr().add(full), p - full, qn);
+                store_first(vs.as_mut_ptr().add(full), p - full, vn);
             }
         }
     }
@@ -552,7 +571,7 @@ mod avx2 {
                     tail(c.as_ptr().add(full), m),
                     tail(vs.as_ptr().add(full), m),
                 );
-                _mm256_maskstore_pd(out.as_mut_ptr().add(full), m, x);
+                store_first(out.as_mut_ptr().add(full), p - full, x);
             }
         }
     }
@@ -607,7 +626,7 @@ mod avx2 {
                     tail(vs.as_ptr().add(full), m),
                     _mm256_mul_pd(hh, tail(a.as_ptr().add(full), m)),
                 );
-                _mm256_maskstore_pd(v.as_mut_ptr().add(full), m, x);
+                store_first(v.as_mut_ptr().add(full), p - full, x);
                 let qi = tail(q.as_ptr().add(full), m);
                 let wq = _mm256_mul_pd(tail(w2.as_ptr().add(full), m), qi);
                 e = _mm256_add_pd(e, _mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(wq, qi)));
@@ -615,8 +634,7 @@ mod avx2 {
                 d = _mm256_add_pd(d, _mm256_mul_pd(cx, x));
                 w = _mm256_add_pd(w, _mm256_mul_pd(tail(f.as_ptr().add(full), m), x));
             }
-            let (e, d, w) = (lanes(e), lanes(d), lanes(w));
-            (0.5 * combine(e), combine(d), combine(w))
+            (0.5 * sum(e), sum(d), sum(w))
         }
     }
 }

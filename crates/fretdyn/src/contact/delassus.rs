@@ -276,11 +276,10 @@ impl TangentialProblem {
                 self.b[2 * k + a] = acceleration + (velocity - vimp[a]) * inverse_theta_dt;
             }
             self.newton[k].set(f64::NAN);
-            self.diagonal[k] = if fixed_k {
-                self.diagonal_fixed[ck]
-            } else {
-                DiagonalBlock::new(self.block(k, k), self.exact)
-            };
+            if !fixed_k {
+                // a fixed contact's block was prepared once ([`Self::diagonal_block`])
+                self.diagonal[k] = DiagonalBlock::new(self.block(k, k), self.exact);
+            }
         }
     }
 
@@ -307,10 +306,16 @@ impl TangentialProblem {
         &self.newton[k]
     }
 
-    /// `H_kk` prepared for its local solve, formed by [`Self::assemble`].
+    /// `H_kk` prepared for its local solve: prepared once for a fixed contact
+    /// ([`Self::fix_rows`]), by [`Self::assemble`] for the others.
     #[inline]
     pub fn diagonal_block(&self, k: usize) -> &DiagonalBlock {
-        &self.diagonal[k]
+        let c = self.slots[k].contact;
+        if self.fixed[c] {
+            &self.diagonal_fixed[c]
+        } else {
+            &self.diagonal[k]
+        }
     }
 
     /// `b_k`.
@@ -363,6 +368,13 @@ impl TangentialProblem {
         self.sweep[k].set([rhs, change]);
     }
 
+    /// Slot `k`'s last recorded local solve: its right-hand side and change
+    /// ([`Self::record_sweep`]).
+    #[inline]
+    pub fn recorded_sweep(&self, k: usize) -> [Vector2<f64>; 2] {
+        self.sweep[k].get()
+    }
+
     /// [`Self::natural_map_residual`] at the end of a Gauss–Seidel sweep whose every local
     /// solve was recorded ([`Self::record_sweep`]), without forming `Hλ` again: slot `k`'s
     /// right-hand side saw the new λ of the slots before it and the old λ of those after it,
@@ -377,7 +389,7 @@ impl TangentialProblem {
         let m = self.slots.len().min(lambda.len());
         self.natural_map(lambda, slide, |k| {
             let [c, _] = self.sweep[k].get();
-            let mut w = c - self.diagonal[k].h * lambda[k];
+            let mut w = c - self.diagonal_block(k).h * lambda[k];
             for j in k + 1..m {
                 w -= self.block(k, j) * self.sweep[j].get()[1];
             }
@@ -397,7 +409,7 @@ impl TangentialProblem {
         let mut l2 = 0.0;
         let mut s_max = 0.0f64;
         for (k, slot) in self.slots.iter().enumerate() {
-            let rho = self.diagonal[k].rho();
+            let rho = self.diagonal_block(k).rho();
             let s = match slide[k] {
                 Slide::Stick => slot.s_static,
                 Slide::Slip => slot.s_dynamic,
@@ -436,7 +448,8 @@ impl TangentialProblem {
     ///
     /// When every closed contact's rows are fixed (planes, bars), `H` depends only on which
     /// contacts are closed: the factorisation is then redone only when that set changes
-    /// (at an impact or a release), and the last answer is given otherwise.
+    /// (at an impact or a release), and the last answer is given otherwise. More than `p`
+    /// rows (2m > p) make `H` singular by its rank: no factorisation then.
     pub fn is_singular(&mut self, work: &mut [f64]) -> bool {
         let n = 2 * self.slots.len();
         if n == 0 {
@@ -454,7 +467,9 @@ impl TangentialProblem {
         {
             return self.singular == Some(true);
         }
-        let singular = self.factor_singular(work, n);
+        // H = L A⁻¹ Lᵀ has rank at most p: more than p rows of L are dependent, and the
+        // factorisation would only confirm it
+        let singular = n > self.p || self.factor_singular(work, n);
         self.singular = all_fixed.then_some(singular);
         self.singular_for.clear();
         self.singular_for

@@ -336,6 +336,9 @@ fn drive(
             }
         }
     }
+    // the step loop's time (RunResults::wall_time): the last flush and checkpoint are the
+    // run's output, as the set-up is its input
+    let wall_time = start.elapsed().as_secs_f64();
     files.flush(&mut sim)?;
     if !matches!(termination, Termination::Diverged { .. }) {
         files.checkpoint(&mut sim, fingerprint)?;
@@ -344,7 +347,6 @@ fn drive(
         step: sim.steps_done(),
         total,
     });
-    let wall_time = start.elapsed().as_secs_f64();
     let mut results = sim.finish(wall_time, termination);
     // impacts in progress and the last partial block, ended with the run
     files.write_impacts(&results.impacts)?;

@@ -25,19 +25,18 @@ impl Simulation<'_> {
         let mut contact_damping = 0.0;
         let mut tangential = 0.0;
         let mut obstacle = 0.0;
-        for (c, s) in self.model.contacts.iter().zip(&self.contacts) {
-            if s.closed {
-                let d = s.frame.penetration;
-                e += 0.5 * c.normal.stiffness * d * d;
-                if c.normal.damping > 0.0 {
-                    // (R_N − K_N δ) δ̇: zero without damping
-                    contact_damping += (s.normal_force - c.normal.stiffness * d) * -s.v_normal;
-                }
-                tangential -= s.tangential_force.dot(&s.tangential_velocity());
-                if !c.motion.is_fixed() {
-                    // a moving obstacle works on the structure at the rate R·v_obstacle
-                    obstacle += s.force().dot(&s.frame.velocity);
-                }
+        for &k in &self.closed {
+            let (c, s) = (&self.model.contacts[k], &self.contacts[k]);
+            let d = s.frame.penetration;
+            e += 0.5 * c.normal.stiffness * d * d;
+            if c.normal.damping > 0.0 {
+                // (R_N − K_N δ) δ̇: zero without damping
+                contact_damping += (s.normal_force - c.normal.stiffness * d) * -s.v_normal;
+            }
+            tangential -= s.tangential_force.dot(&s.tangential_velocity());
+            if !c.motion.is_fixed() {
+                // a moving obstacle works on the structure at the rate R·v_obstacle
+                obstacle += s.force().dot(&s.frame.velocity);
             }
         }
         (

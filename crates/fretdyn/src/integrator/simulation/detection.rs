@@ -74,6 +74,7 @@ impl Simulation<'_> {
         };
         let p = self.cd.q.len();
         let penalty = matches!(self.tangential, Tangential::Penalty { .. });
+        self.closed.clear();
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
             state.tangential_force = Vector2::zeros();
             state.held = false;
@@ -93,6 +94,7 @@ impl Simulation<'_> {
                 state.normal_force = 0.0;
                 continue;
             }
+            self.closed.push(k);
             // an open contact's velocity is only needed at output samples
             if !c.motion.is_fixed() {
                 state.frame.velocity = c.motion.at(t).1;
@@ -130,25 +132,38 @@ impl Simulation<'_> {
     /// of a contact [held](ContactState::held) in stick is read as exactly 0, THEORY §5.)
     #[inline(always)]
     pub(super) fn full_step_velocities<K: Lanes>(&mut self, all: bool) {
+        if all {
+            for k in 0..self.contacts.len() {
+                self.full_step_velocity::<K>(k);
+            }
+        } else {
+            // the list is moved out and back (no allocation) while the contacts change
+            let closed = std::mem::take(&mut self.closed);
+            for &k in &closed {
+                self.full_step_velocity::<K>(k);
+            }
+            self.closed = closed;
+        }
+    }
+
+    /// [`Self::full_step_velocities`] of contact `k`.
+    #[inline(always)]
+    fn full_step_velocity<K: Lanes>(&mut self, k: usize) {
         let p = self.cd.q.len();
-        for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
-            if !(state.closed || all) {
-                continue;
-            }
-            if !c.motion.is_fixed() {
-                state.frame.velocity = moving_full_step(&c.motion, self.step, self.settings.dt);
-            }
-            match &self.frame_rows[k] {
-                Some(rows) => state.set_velocity::<K>(Kinematics::Rows(rows), c, &self.cd.qd, true),
-                None => {
-                    let pt = &self.model.basis.points[c.point];
-                    if c.at_surface() && !state.closed {
-                        let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
-                        c.surface_rows(pt, &state.frame.normal, out);
-                    }
-                    let rows = contact_rows(self.model, &self.surface_rows, k);
-                    state.set_velocity::<K>(Kinematics::Point(rows), c, &self.cd.qd, true);
+        let (c, state) = (&self.model.contacts[k], &mut self.contacts[k]);
+        if !c.motion.is_fixed() {
+            state.frame.velocity = moving_full_step(&c.motion, self.step, self.settings.dt);
+        }
+        match &self.frame_rows[k] {
+            Some(rows) => state.set_velocity::<K>(Kinematics::Rows(rows), c, &self.cd.qd, true),
+            None => {
+                let pt = &self.model.basis.points[c.point];
+                if c.at_surface() && !state.closed {
+                    let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
+                    c.surface_rows(pt, &state.frame.normal, out);
                 }
+                let rows = contact_rows(self.model, &self.surface_rows, k);
+                state.set_velocity::<K>(Kinematics::Point(rows), c, &self.cd.qd, true);
             }
         }
     }

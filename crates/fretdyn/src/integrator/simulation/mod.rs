@@ -181,6 +181,9 @@ pub struct Simulation<'m> {
     settings: &'m RunSettings,
     cd: CentralDifference,
     contacts: Vec<ContactState>,
+    /// The contacts closed at this step, in order (set by detection): the phases after it
+    /// visit these only.
+    closed: Vec<usize>,
     tangential: Tangential,
     /// Rows (3 × p) of the contact points on the tube surface, one block per contact (used
     /// only by contacts with a radius), updated with the normal at each step (once for a
@@ -555,6 +558,7 @@ impl<'m> Simulation<'m> {
             settings,
             cd,
             contacts,
+            closed: Vec::with_capacity(nc),
             tangential,
             surface_rows,
             frame_rows,

@@ -8,9 +8,8 @@ impl Simulation<'_> {
     /// Step 4 (and the penalty tangential forces): modal force `f = f_ext + Σ Φ_cᵀ R_c`.
     #[inline(always)]
     pub(super) fn contact_forces(&mut self) {
-        self.force.copy_from_slice(&self.external);
-        for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
-            if let Tangential::Penalty { settings, contacts } = &mut self.tangential {
+        if let Tangential::Penalty { settings, contacts } = &mut self.tangential {
+            for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
                 if state.closed {
                     let vt = state.tangential_velocity();
                     state.tangential_force = contacts[k].force(
@@ -26,20 +25,22 @@ impl Simulation<'_> {
                     contacts[k].open();
                 }
             }
-            if state.closed {
-                match &self.frame_rows[k] {
-                    Some(rows) => rows.project_add(
-                        &state.frame.normal,
-                        state.normal_force,
-                        &state.tangential_force,
-                        &mut self.force,
-                    ),
-                    None => project_add(
-                        contact_rows(self.model, &self.surface_rows, k),
-                        &state.force(),
-                        &mut self.force,
-                    ),
-                }
+        }
+        self.force.copy_from_slice(&self.external);
+        for &k in &self.closed {
+            let state = &self.contacts[k];
+            match &self.frame_rows[k] {
+                Some(rows) => rows.project_add(
+                    &state.frame.normal,
+                    state.normal_force,
+                    &state.tangential_force,
+                    &mut self.force,
+                ),
+                None => project_add(
+                    contact_rows(self.model, &self.surface_rows, k),
+                    &state.force(),
+                    &mut self.force,
+                ),
             }
         }
     }

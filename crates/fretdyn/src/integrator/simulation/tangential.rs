@@ -32,20 +32,19 @@ impl Simulation<'_> {
             return;
         };
         problem.clear();
-        for (k, (c, state)) in self.model.contacts.iter().zip(&self.contacts).enumerate() {
-            if state.closed {
-                let cd = &self.cd;
-                problem.push_with(
-                    Slot {
-                        contact: k,
-                        s_static: c.friction.mu_static * state.normal_force,
-                        s_dynamic: c.friction.mu_dynamic * state.normal_force,
-                    },
-                    &state.frame.tangents,
-                    contact_rows(self.model, &self.surface_rows, k),
-                    |l, out| cd.apply_a_inv(l, out),
-                );
-            }
+        for &k in &self.closed {
+            let (c, state) = (&self.model.contacts[k], &self.contacts[k]);
+            let cd = &self.cd;
+            problem.push_with(
+                Slot {
+                    contact: k,
+                    s_static: c.friction.mu_static * state.normal_force,
+                    s_dynamic: c.friction.mu_dynamic * state.normal_force,
+                },
+                &state.frame.tangents,
+                contact_rows(self.model, &self.surface_rows, k),
+                |l, out| cd.apply_a_inv(l, out),
+            );
         }
         if problem.is_empty() {
             history.iter_mut().for_each(|h| h.closed = false);
