@@ -6,8 +6,8 @@
 //!
 //! Both sum in four lanes: lane `k` accumulates the terms `i ≡ k (mod 4)` of the whole chunks
 //! of four, in order; the remaining `r < 4` terms are then added to lanes `0..r` and, when
-//! `r > 0`, `+0` to the others (one masked vector operation: it changes a lane's `−0` into
-//! `+0`, nothing else); the result is `(s₀ + s₁) + (s₂ + s₃)`. Each lane does the same multiplications and additions in the same
+//! `r > 0`, `+0` to the others (one vector operation on the tail loaded with zeros after it:
+//! it changes a lane's `−0` into `+0`, nothing else); the result is `(s₀ + s₁) + (s₂ + s₃)`. Each lane does the same multiplications and additions in the same
 //! order in both implementations (no fused multiply-add), so they agree bit for bit
 //! (tested below and in `tests/vector_width.rs`). The compiler does not turn such four-lane
 //! sums into clean vector code by itself, hence the intrinsics.
@@ -66,7 +66,7 @@ fn combine(s: [f64; 4]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3])
 }
 
-/// The masked tail's `+0` on the lanes `r..4` of each sum, when `r > 0` (module documentation).
+/// The tail's `+0` on the lanes `r..4` of each sum, when `r > 0` (module documentation).
 #[inline(always)]
 fn masked_zeros(sums: &mut [&mut [f64; 4]], r: usize) {
     if r > 0 {
@@ -271,30 +271,30 @@ impl Lanes for Avx2 {
 #[allow(unused_unsafe)]
 mod avx2 {
     use std::arch::x86_64::{
-        __m256d, __m256i, _mm_add_sd, _mm_cvtsd_f64, _mm_hadd_pd, _mm_store_sd, _mm_storeu_pd,
-        _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128, _mm256_extractf128_pd,
-        _mm256_loadu_pd, _mm256_loadu_si256, _mm256_maskload_pd, _mm256_mul_pd, _mm256_set1_pd,
-        _mm256_setzero_pd, _mm256_storeu_pd, _mm256_sub_pd,
+        __m256d, _mm_add_sd, _mm_cvtsd_f64, _mm_hadd_pd, _mm_load_sd, _mm_loadu_pd, _mm_store_sd,
+        _mm_storeu_pd, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128,
+        _mm256_extractf128_pd, _mm256_insertf128_pd, _mm256_loadu_pd, _mm256_mul_pd,
+        _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd, _mm256_sub_pd, _mm256_zextpd128_pd256,
     };
 
-    /// `MASKS[r]`: the first `r` lanes.
-    static MASKS: [[i64; 4]; 4] = [[0, 0, 0, 0], [-1, 0, 0, 0], [-1, -1, 0, 0], [-1, -1, -1, 0]];
-
-    /// The mask of the first `r < 4` lanes.
+    /// The `r < 4` values at `p` in the first lanes, the others `+0`: one 64-bit load, one
+    /// 128-bit load or both, which read the `r` values only (a masked 256-bit load waits on
+    /// its mask and is slow on some processors).
     #[inline]
     #[target_feature(enable = "avx2")]
-    unsafe fn first(r: usize) -> __m256i {
-        // SAFETY: MASKS[r & 3] holds 4 values
-        unsafe { _mm256_loadu_si256(MASKS[r & 3].as_ptr().cast()) }
-    }
-
-    /// The `r < 4` values at `p` (the lanes after them 0): a masked load, which reads (and
-    /// may fault on) the `r` values only.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    unsafe fn tail(p: *const f64, mask: __m256i) -> __m256d {
-        // SAFETY: the caller's `p..p + r` is inside a slice; the masked lanes are not read
-        unsafe { _mm256_maskload_pd(p, mask) }
+    unsafe fn tail(p: *const f64, r: usize) -> __m256d {
+        // SAFETY: the caller's `p..p + r` is inside a slice
+        unsafe {
+            match r {
+                1 => _mm256_zextpd128_pd256(_mm_load_sd(p)),
+                2 => _mm256_zextpd128_pd256(_mm_loadu_pd(p)),
+                3 => _mm256_insertf128_pd::<1>(
+                    _mm256_zextpd128_pd256(_mm_loadu_pd(p)),
+                    _mm_load_sd(p.add(2)),
+                ),
+                _ => _mm256_setzero_pd(),
+            }
+        }
     }
 
     /// `(x₀ + x₁) + (x₂ + x₃)`, [`super::combine`] of the four lanes, in registers: one
@@ -337,7 +337,7 @@ mod avx2 {
         let n = a.len().min(b.len());
         let full = n - n % 4;
         // SAFETY: AVX2 (the caller's guarantee); every load reads i..i + 4 ≤ full ≤ n, the
-        // tail's masked loads full..n
+        // tail's loads full..n
         unsafe {
             let (pa, pb) = (a.as_ptr(), b.as_ptr());
             let mut acc = _mm256_setzero_pd();
@@ -364,7 +364,7 @@ mod avx2 {
                 );
             }
             if n > full {
-                let m = first(n - full);
+                let m = n - full;
                 acc = _mm256_add_pd(
                     acc,
                     _mm256_mul_pd(tail(pa.add(full), m), tail(pb.add(full), m)),
@@ -384,7 +384,7 @@ mod avx2 {
         let n = a.len().min(b.len()).min(c.len());
         let full = n - n % 4;
         // SAFETY: AVX2 (the caller's guarantee); every load reads i..i + 4 ≤ full ≤ n, the
-        // tail's masked loads full..n
+        // tail's loads full..n
         unsafe {
             let (pa, pb, pc) = (a.as_ptr(), b.as_ptr(), c.as_ptr());
             let (mut s, mut t) = (_mm256_setzero_pd(), _mm256_setzero_pd());
@@ -396,7 +396,7 @@ mod avx2 {
                 i += 4;
             }
             if n > full {
-                let m = first(n - full);
+                let m = n - full;
                 let x = tail(pa.add(full), m);
                 s = _mm256_add_pd(s, _mm256_mul_pd(x, tail(pb.add(full), m)));
                 t = _mm256_add_pd(t, _mm256_mul_pd(x, tail(pc.add(full), m)));
@@ -442,7 +442,7 @@ mod avx2 {
                     i += 4;
                 }
                 if p > full {
-                    let m = first(p - full);
+                    let m = p - full;
                     let y = tail(x.as_ptr().add(full), m);
                     s0 = _mm256_add_pd(s0, _mm256_mul_pd(tail(base.add(full), m), y));
                     s1 = _mm256_add_pd(s1, _mm256_mul_pd(tail(base.add(p + full), m), y));
@@ -462,7 +462,7 @@ mod avx2 {
     }
 
     /// [`super::Portable::predict`] on AVX2: four modes at a time, the last `p mod 4` by
-    /// one masked load and store.
+    /// plain loads and stores of the first lanes ([`tail`], [`store_first`]).
     ///
     /// # Safety
     /// The processor must have AVX2.
@@ -480,7 +480,7 @@ mod avx2 {
         let (vs, v, a) = (&mut vs[..p], &v[..p], &a[..p]);
         let full = p - p % 4;
         // SAFETY: AVX2 (the caller's guarantee); every load and store touches i..i + 4 ≤ full,
-        // the tail's masked ones full..p, within every slice
+        // the tail's ones full..p, within every slice
         unsafe {
             let (dtv, hh, hdt) = (
                 _mm256_set1_pd(dt),
@@ -508,20 +508,20 @@ mod avx2 {
                 i += 4;
             }
             if p > full {
-                let m = first(p - full);
+                let m = p - full;
                 let (qn, vn) = step(
                     tail(q.as_ptr().add(full), m),
                     tail(v.as_ptr().add(full), m),
                     tail(a.as_ptr().add(full), m),
                 );
-                store_first(q.as_mut_ptr().add(full), p - full, qn);
-                store_first(vs.as_mut_ptr().add(full), p - full, vn);
+                store_first(q.as_mut_ptr().add(full), m, qn);
+                store_first(vs.as_mut_ptr().add(full), m, vn);
             }
         }
     }
 
     /// [`super::Portable::free_acceleration`] on AVX2: four modes at a time, the last
-    /// `p mod 4` by masked loads and a masked store.
+    /// `p mod 4` by [`tail`] and [`store_first`].
     ///
     /// # Safety
     /// The processor must have AVX2.
@@ -562,7 +562,7 @@ mod avx2 {
                 i += 4;
             }
             if p > full {
-                let m = first(p - full);
+                let m = p - full;
                 let x = value(
                     tail(ai.as_ptr().add(full), m),
                     tail(f.as_ptr().add(full), m),
@@ -571,7 +571,7 @@ mod avx2 {
                     tail(c.as_ptr().add(full), m),
                     tail(vs.as_ptr().add(full), m),
                 );
-                store_first(out.as_mut_ptr().add(full), p - full, x);
+                store_first(out.as_mut_ptr().add(full), m, x);
             }
         }
     }
@@ -621,12 +621,12 @@ mod avx2 {
                 i += 4;
             }
             if p > full {
-                let m = first(p - full);
+                let m = p - full;
                 let x = _mm256_add_pd(
                     tail(vs.as_ptr().add(full), m),
                     _mm256_mul_pd(hh, tail(a.as_ptr().add(full), m)),
                 );
-                store_first(v.as_mut_ptr().add(full), p - full, x);
+                store_first(v.as_mut_ptr().add(full), m, x);
                 let qi = tail(q.as_ptr().add(full), m);
                 let wq = _mm256_mul_pd(tail(w2.as_ptr().add(full), m), qi);
                 e = _mm256_add_pd(e, _mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(wq, qi)));

@@ -248,7 +248,19 @@ impl TangentialProblem {
             // the 2 × 2 blocks H_kl, l ≥ k, and their transposes
             for l in k..m {
                 let cl = self.slots[l].contact;
-                let fixed = fixed_k && self.fixed[cl];
+                if fixed_k && self.fixed[cl] {
+                    // gathered whole: h_fixed is exactly symmetric (fix_rows)
+                    for a in 0..2 {
+                        let from = &self.h_fixed[(2 * ck + a) * st + 2 * cl..][..2];
+                        let (x, y) = (from[0], from[1]);
+                        let row = (2 * k + a) * st + 2 * l;
+                        self.h[row] = x;
+                        self.h[row + 1] = y;
+                        self.h[2 * l * st + 2 * k + a] = x;
+                        self.h[(2 * l + 1) * st + 2 * k + a] = y;
+                    }
+                    continue;
+                }
                 for a in 0..2 {
                     let (hr, lr) = (2 * k + a, 2 * ck + a);
                     for b in 0..2 {
@@ -256,14 +268,10 @@ impl TangentialProblem {
                             continue; // the diagonal block's lower half, by symmetry
                         }
                         let (hc, lc) = (2 * l + b, 2 * cl + b);
-                        let v = if fixed {
-                            self.h_fixed[lr * st + lc]
-                        } else {
-                            K::dot(
-                                &self.l[lr * p..(lr + 1) * p],
-                                &self.al[lc * p..(lc + 1) * p],
-                            )
-                        };
+                        let v = K::dot(
+                            &self.l[lr * p..(lr + 1) * p],
+                            &self.al[lc * p..(lc + 1) * p],
+                        );
                         self.h[hr * st + hc] = v;
                         self.h[hc * st + hr] = v;
                     }
@@ -331,13 +339,17 @@ impl TangentialProblem {
         let row0 = &self.h[2 * k * self.stride..][..2 * m];
         let row1 = &self.h[(2 * k + 1) * self.stride..][..2 * m];
         let (mut c0, mut c1) = (self.b[2 * k], self.b[2 * k + 1]);
-        for (l, ((lam, h0), h1)) in lambda[..m]
-            .iter()
-            .zip(row0.chunks_exact(2))
-            .zip(row1.chunks_exact(2))
-            .enumerate()
-        {
-            if l != k {
+        // the contacts before k, then those after it (in order: the same sums)
+        for range in [0..k.min(m), (k + 1).min(m)..m] {
+            let (row0, row1) = (
+                &row0[2 * range.start..2 * range.end],
+                &row1[2 * range.start..2 * range.end],
+            );
+            for ((lam, h0), h1) in lambda[range]
+                .iter()
+                .zip(row0.chunks_exact(2))
+                .zip(row1.chunks_exact(2))
+            {
                 c0 -= h0[0] * lam.x + h0[1] * lam.y;
                 c1 -= h1[0] * lam.x + h1[1] * lam.y;
             }
@@ -449,7 +461,7 @@ impl TangentialProblem {
     /// When every closed contact's rows are fixed (planes, bars), `H` depends only on which
     /// contacts are closed: the factorisation is then redone only when that set changes
     /// (at an impact or a release), and the last answer is given otherwise. More than `p`
-    /// rows (2m > p) make `H` singular by its rank: no factorisation then.
+    /// rows (2m > p) make `H` singular by its rank: no factorisation then (THEORY §4.6).
     pub fn is_singular(&mut self, work: &mut [f64]) -> bool {
         let n = 2 * self.slots.len();
         if n == 0 {

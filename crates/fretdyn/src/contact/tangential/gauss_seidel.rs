@@ -74,7 +74,8 @@ pub fn solve(
         {
             // A single contact: the next sweep solves the same local problem (no other λ
             // changed its right-hand side), and the radial solve returns the same λ, a
-            // change of exactly 0 that passes the test. It is counted, not recomputed.
+            // change of exactly 0 that passes the test. It is counted, not recomputed
+            // (THEORY §4.4).
             let [c, _] = problem.recorded_sweep(0);
             problem.record_sweep(0, c, Vector2::zeros());
             return Sweeps {
