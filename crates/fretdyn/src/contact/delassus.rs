@@ -256,8 +256,10 @@ impl TangentialProblem {
                         let row = (2 * k + a) * st + 2 * l;
                         self.h[row] = x;
                         self.h[row + 1] = y;
-                        self.h[2 * l * st + 2 * k + a] = x;
-                        self.h[(2 * l + 1) * st + 2 * k + a] = y;
+                        if l != k {
+                            self.h[2 * l * st + 2 * k + a] = x;
+                            self.h[(2 * l + 1) * st + 2 * k + a] = y;
+                        }
                     }
                     continue;
                 }
@@ -339,17 +341,13 @@ impl TangentialProblem {
         let row0 = &self.h[2 * k * self.stride..][..2 * m];
         let row1 = &self.h[(2 * k + 1) * self.stride..][..2 * m];
         let (mut c0, mut c1) = (self.b[2 * k], self.b[2 * k + 1]);
-        // the contacts before k, then those after it (in order: the same sums)
-        for range in [0..k.min(m), (k + 1).min(m)..m] {
-            let (row0, row1) = (
-                &row0[2 * range.start..2 * range.end],
-                &row1[2 * range.start..2 * range.end],
-            );
-            for ((lam, h0), h1) in lambda[range]
-                .iter()
-                .zip(row0.chunks_exact(2))
-                .zip(row1.chunks_exact(2))
-            {
+        for (l, ((lam, h0), h1)) in lambda[..m]
+            .iter()
+            .zip(row0.chunks_exact(2))
+            .zip(row1.chunks_exact(2))
+            .enumerate()
+        {
+            if l != k {
                 c0 -= h0[0] * lam.x + h0[1] * lam.y;
                 c1 -= h1[0] * lam.x + h1[1] * lam.y;
             }
