@@ -7,7 +7,8 @@
 //! Both sum in four lanes: lane `k` accumulates the terms `i ≡ k (mod 4)` of the whole chunks
 //! of four, in order; the remaining `r < 4` terms are then added to lanes `0..r` and, when
 //! `r > 0`, `+0` to the others (one vector operation on the tail loaded with zeros after it:
-//! it changes a lane's `−0` into `+0`, nothing else); the result is `(s₀ + s₁) + (s₂ + s₃)`. Each lane does the same multiplications and additions in the same
+//! it changes a lane's `−0` into `+0`, nothing else); the result is `(s₀ + s₁) + (s₂ + s₃)`.
+//! Each lane does the same multiplications and additions in the same
 //! order in both implementations (no fused multiply-add), so they agree bit for bit
 //! (tested below and in `tests/vector_width.rs`). The compiler does not turn such four-lane
 //! sums into clean vector code by itself, hence the intrinsics.

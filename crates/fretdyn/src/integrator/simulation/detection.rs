@@ -137,12 +137,9 @@ impl Simulation<'_> {
                 self.full_step_velocity::<K>(k);
             }
         } else {
-            // the list is moved out and back (no allocation) while the contacts change
-            let closed = std::mem::take(&mut self.closed);
-            for &k in &closed {
-                self.full_step_velocity::<K>(k);
+            for i in 0..self.closed.len() {
+                self.full_step_velocity::<K>(self.closed[i]);
             }
-            self.closed = closed;
         }
     }
 
