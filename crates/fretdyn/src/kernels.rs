@@ -28,6 +28,11 @@ pub(crate) trait Lanes: Copy {
     /// row, `out.len()` rows), each summed exactly as [`Self::dot`] sums it: one pass over `x`
     /// serves four rows.
     fn dots(a: &[f64], x: &[f64], out: &mut [f64]);
+    /// `y_i += a x_i` (slices of equal length; elementwise, so every width gives the same
+    /// bits): the contact forces added to the modal force, the loads, `q̈ −= A⁻¹Lᵀλ`.
+    fn axpy(y: &mut [f64], a: f64, x: &[f64]);
+    /// `y_i = a x_i` (slices of equal length; elementwise).
+    fn scale(y: &mut [f64], a: f64, x: &[f64]);
     /// Steps 1–2 of central differences: `q_i += Δt v_i + (h Δt) a_i`, `vs_i = v_i + h a_i`
     /// (slices of equal length; elementwise, so every width gives the same bits).
     fn predict(q: &mut [f64], vs: &mut [f64], v: &[f64], a: &[f64], dt: f64, h: f64);
@@ -133,6 +138,20 @@ impl Lanes for Portable {
     }
 
     #[inline(always)]
+    fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+        for (o, v) in y.iter_mut().zip(x) {
+            *o += a * v;
+        }
+    }
+
+    #[inline(always)]
+    fn scale(y: &mut [f64], a: f64, x: &[f64]) {
+        for (o, v) in y.iter_mut().zip(x) {
+            *o = a * v;
+        }
+    }
+
+    #[inline(always)]
     fn predict(q: &mut [f64], vs: &mut [f64], v: &[f64], a: &[f64], dt: f64, h: f64) {
         let p = q.len();
         let (vs, v, a) = (&mut vs[..p], &v[..p], &a[..p]);
@@ -228,6 +247,18 @@ impl Lanes for Avx2 {
     fn dots(a: &[f64], x: &[f64], out: &mut [f64]) {
         // SAFETY: as above
         unsafe { avx2::dots(a, x, out) }
+    }
+
+    #[inline(always)]
+    fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+        // SAFETY: as above
+        unsafe { avx2::axpy(y, a, x) }
+    }
+
+    #[inline(always)]
+    fn scale(y: &mut [f64], a: f64, x: &[f64]) {
+        // SAFETY: as above
+        unsafe { avx2::scale(y, a, x) }
     }
 
     #[inline(always)]
@@ -460,6 +491,70 @@ mod avx2 {
                 r += 1;
             }
         }
+    }
+
+    /// [`super::Portable::axpy`] on AVX2 when `SET` is false, [`super::Portable::scale`]
+    /// when it is true: four values at a time, the last `n mod 4` by [`tail`] and
+    /// [`store_first`].
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn scaled<const SET: bool>(y: &mut [f64], a: f64, x: &[f64]) {
+        let n = y.len().min(x.len());
+        let full = n - n % 4;
+        // SAFETY: AVX2 (the caller's guarantee); every load and store touches i..i + 4 ≤ full,
+        // the tail's ones full..n, within both slices
+        unsafe {
+            let av = _mm256_set1_pd(a);
+            let value = |y: __m256d, x: __m256d| {
+                let ax = _mm256_mul_pd(av, x);
+                if SET { ax } else { _mm256_add_pd(y, ax) }
+            };
+            let (py, px) = (y.as_mut_ptr(), x.as_ptr());
+            let mut i = 0;
+            while i < full {
+                let y = if SET {
+                    _mm256_setzero_pd()
+                } else {
+                    _mm256_loadu_pd(py.add(i))
+                };
+                _mm256_storeu_pd(py.add(i), value(y, _mm256_loadu_pd(px.add(i))));
+                i += 4;
+            }
+            if n > full {
+                let m = n - full;
+                let y = if SET {
+                    _mm256_setzero_pd()
+                } else {
+                    tail(py.add(full), m)
+                };
+                store_first(py.add(full), m, value(y, tail(px.add(full), m)));
+            }
+        }
+    }
+
+    /// [`super::Portable::axpy`] on AVX2.
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+        // SAFETY: the caller's
+        unsafe { scaled::<false>(y, a, x) }
+    }
+
+    /// [`super::Portable::scale`] on AVX2.
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn scale(y: &mut [f64], a: f64, x: &[f64]) {
+        // SAFETY: the caller's
+        unsafe { scaled::<true>(y, a, x) }
     }
 
     /// [`super::Portable::predict`] on AVX2: four modes at a time, the last `p mod 4` by
@@ -730,6 +825,22 @@ mod tests {
                 v1.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
                 v2.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
             );
+            // axpy and scale: element by element as defined, and nothing written past the
+            // slice (the AVX2 tail's stores)
+            let (mut y1, mut y2) = (q.clone(), q.clone());
+            y1.push(f64::NAN);
+            Avx2::axpy(&mut y1[..n], -0.37, &a);
+            Portable::axpy(&mut y2, -0.37, &a);
+            let expected: Vec<u64> = (0..n).map(|i| (q[i] + -0.37 * a[i]).to_bits()).collect();
+            assert_eq!(all(&y1[..n]), expected, "{n}");
+            assert_eq!(all(&y2), expected, "{n}");
+            assert!(y1[n].is_nan());
+            Avx2::scale(&mut y1[..n], 1.7, &b);
+            Portable::scale(&mut y2, 1.7, &b);
+            let expected: Vec<u64> = (0..n).map(|i| (1.7 * b[i]).to_bits()).collect();
+            assert_eq!(all(&y1[..n]), expected, "{n}");
+            assert_eq!(all(&y2), expected, "{n}");
+            assert!(y1[n].is_nan());
         }
     }
 }

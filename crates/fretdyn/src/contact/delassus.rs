@@ -435,9 +435,10 @@ impl TangentialProblem {
         if scale > 0.0 { r2.sqrt() / scale } else { 0.0 }
     }
 
-    /// `q̈ −= A⁻¹ Lᵀ λ`.
+    /// `q̈ −= A⁻¹ Lᵀ λ`, row by row with the kernels `K` (`q̈ += (−λ_r) (A⁻¹Lᵀ)_r`: the
+    /// same bits as `q̈ −= λ_r (A⁻¹Lᵀ)_r`).
     #[inline(always)]
-    pub fn apply(&self, lambda: &[Vector2<f64>], qdd: &mut [f64]) {
+    pub(crate) fn apply<K: crate::kernels::Lanes>(&self, lambda: &[Vector2<f64>], qdd: &mut [f64]) {
         let p = self.p;
         for (k, lam) in lambda.iter().enumerate().take(self.slots.len()) {
             for a in 0..2 {
@@ -445,9 +446,7 @@ impl TangentialProblem {
                 let al = &self.al[r * p..(r + 1) * p];
                 let s = lam[a];
                 if s != 0.0 {
-                    for (q, v) in qdd.iter_mut().zip(al) {
-                        *q -= v * s;
-                    }
+                    K::axpy(qdd, -s, al);
                 }
             }
         }

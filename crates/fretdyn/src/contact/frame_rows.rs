@@ -20,7 +20,7 @@ use crate::contact::Contact;
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::ContactFrame;
 use crate::kernels::Lanes;
-use crate::structure::modal::{Point, axpy};
+use crate::structure::modal::Point;
 
 /// The frame rows of one contact (see the module's documentation).
 #[derive(Debug, Clone, PartialEq)]
@@ -160,19 +160,19 @@ impl FrameRows {
     /// `f += Φ_cᵀ (R_N n + T R_T)` for the frame's normal `normal` (the declared one or its
     /// opposite).
     #[inline(always)]
-    pub fn project_add(
+    pub(crate) fn project_add<K: Lanes>(
         &self,
         normal: &Vector3<f64>,
         normal_force: f64,
         tangential: &Vector2<f64>,
         f: &mut [f64],
     ) {
-        axpy(f, self.sign(normal) * normal_force, self.row(0));
+        K::axpy(f, self.sign(normal) * normal_force, self.row(0));
         if tangential.x != 0.0 {
-            axpy(f, tangential.x, self.row(1));
+            K::axpy(f, tangential.x, self.row(1));
         }
         if tangential.y != 0.0 {
-            axpy(f, tangential.y, self.row(2));
+            K::axpy(f, tangential.y, self.row(2));
         }
     }
 }

@@ -341,18 +341,18 @@ pub const PEAK_BINS_PER_DECADE: usize = 10;
 const PEAK_MIN_DECADE: i32 = -6;
 const PEAK_DECADES: usize = 15;
 
-/// `min(m, x)` for a running minimum `m` that is never NaN: `x` when `x < m`, else `m` (a
-/// NaN `x` is skipped). One comparison; `f64::min` would also test `m` for NaN, and gives the
-/// same value (on x86-64, bit for bit: `minsd` keeps `m` on a tie of zeros too).
+/// `min(m, x)` for a running minimum `m` that is never NaN (a NaN `x` is skipped).
+/// `f64::min`, not `if x < m { x } else { m }`: the compiler turns that select, written back
+/// to `m`, into a conditional (masked) store, microcoded on some processors.
 #[inline(always)]
 fn smaller(m: f64, x: f64) -> f64 {
-    if x < m { x } else { m }
+    m.min(x)
 }
 
 /// `max(m, x)` for a running maximum `m` that is never NaN, as [`smaller`].
 #[inline(always)]
 fn larger(m: f64, x: f64) -> f64 {
-    if x > m { x } else { m }
+    m.max(x)
 }
 
 /// Running sums of one contact over a window or a block. The number of steps is the same for
@@ -1120,7 +1120,6 @@ impl ContactStatisticsState {
     pub fn step(
         &mut self,
         settings: &StatisticsSettings,
-        _names: &[String],
         t: f64,
         dt: f64,
         values: impl Iterator<Item = StepValues>,
@@ -1337,10 +1336,9 @@ mod tests {
         from: u64,
         to: u64,
     ) {
-        let names = names();
         for n in from + 1..=to {
             let t = n as f64 * DT;
-            state.step(settings, &names, t, DT, (0..CONTACTS).map(|k| values(k, n)));
+            state.step(settings, t, DT, (0..CONTACTS).map(|k| values(k, n)));
         }
     }
 

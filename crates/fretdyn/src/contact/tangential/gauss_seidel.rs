@@ -33,6 +33,11 @@ pub fn solve(
     slide: &mut [Slide],
 ) -> Sweeps {
     let m = problem.len();
+    if m == 1 && settings.local_solve == LocalSolve::Radial && settings.max_sweeps >= 2 {
+        if let Some(sweeps) = solve_single_radial(settings, problem, lambda, slide) {
+            return sweeps;
+        }
+    }
     let mut residual = None;
     for sweep in 1..=settings.max_sweeps {
         let mut diff2 = 0.0;
@@ -92,4 +97,49 @@ pub fn solve(
         converged: false,
         residual,
     }
+}
+
+/// [`solve`] of a single closed contact with the radial local solve, the common case of a
+/// rattling structure, without the loops: its local problem's right-hand side is `b` whatever
+/// the λ (no other contact), so the first sweep gives the solution and a second sweep, when
+/// the first one's change does not pass the test, would return the same λ with a change of
+/// exactly 0 (counted, not recomputed: THEORY §4.4). The same operations as the loop of
+/// [`solve`], so the same bits and counts. `None` (λ and statuses as given) when the first
+/// sweep's λ is not finite: [`solve`] then runs its loop.
+#[inline]
+fn solve_single_radial(
+    settings: &GaussSeidelSettings,
+    problem: &TangentialProblem,
+    lambda: &mut [Vector2<f64>],
+    slide: &mut [Slide],
+) -> Option<Sweeps> {
+    let slot = &problem.slots()[0];
+    // local_rhs(0, λ) of a single contact: b_0, nothing subtracted
+    let c = problem.rhs(0);
+    let (new, st) = local_solve_block(
+        problem.diagonal_block(0),
+        &c,
+        slot.s_static,
+        slot.s_dynamic,
+        LocalSolve::Radial,
+        problem.newton_start(0),
+    );
+    let change = new - lambda[0];
+    let (diff2, norm2) = (change.norm_squared(), new.norm_squared());
+    let count = if diff2 <= settings.tolerance * settings.tolerance * norm2 || diff2 == 0.0 {
+        problem.record_sweep(0, c, change);
+        1
+    } else if norm2.is_finite() {
+        problem.record_sweep(0, c, Vector2::zeros());
+        2
+    } else {
+        return None;
+    };
+    lambda[0] = new;
+    slide[0] = st;
+    Some(Sweeps {
+        count,
+        converged: true,
+        residual: Some(problem.natural_map_residual_after_sweep(&lambda[..1], &slide[..1])),
+    })
 }

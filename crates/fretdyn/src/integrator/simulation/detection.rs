@@ -14,38 +14,33 @@ use super::{ContactState, Simulation, Tangential, contact_rows, contact_states};
 use crate::contact::Contact;
 use crate::contact::frame_rows::FrameRows;
 use crate::kernels::Lanes;
-use crate::structure::modal::{axpy, recombine, recombine_with};
+use crate::structure::modal::{recombine, recombine_with};
 
 impl Simulation<'_> {
+    /// The external modal force at `t`: `Σ_l s_l(t) Φ_lᵀ F_l` over the loads' rows, plus the
+    /// turbulence (THEORY §7).
     #[inline(always)]
-    pub(super) fn external_force(&mut self, t: f64) {
+    pub(super) fn external_force<K: Lanes>(&mut self, t: f64) {
         let p = self.external.len();
-        let histories = self.model.loads.iter().map(|l| &l.history);
-        let modal = self.model.modal_loads.iter().map(|l| &l.history);
-        let base = self.model.base_acceleration.iter().map(|b| &b.history);
-        let mut rows = self
-            .load_rows
-            .chunks_exact(p.max(1))
-            .zip(histories.chain(modal).chain(base));
         // the first load sets the force, the others add to it
-        match rows.next() {
-            Some((row, history)) => {
-                let s = history.value(t);
-                for (f, g) in self.external.iter_mut().zip(row) {
-                    *f = s * g;
+        match self.load_histories.split_first() {
+            Some((first, others)) => {
+                K::scale(&mut self.external, first.value(t), &self.load_rows[..p]);
+                for (history, row) in others
+                    .iter()
+                    .zip(self.load_rows[p..].chunks_exact(p.max(1)))
+                {
+                    K::axpy(&mut self.external, history.value(t), row);
                 }
             }
             None => self.external.fill(0.0),
-        }
-        for (row, history) in rows {
-            axpy(&mut self.external, history.value(t), row);
         }
         for (load, generator) in self.model.turbulence.iter().zip(&mut self.turbulence) {
             let r = generator.channels();
             let xi = &mut self.signals[..r];
             generator.values(t, xi);
             for (x, row) in xi.iter().zip(load.rows.chunks_exact(p.max(1))) {
-                axpy(&mut self.external, *x, row);
+                K::axpy(&mut self.external, *x, row);
             }
         }
     }
@@ -64,9 +59,11 @@ impl Simulation<'_> {
     }
 
     /// Step 3: penetrations, frames, velocities (predicted when `predicted`) and normal
-    /// forces at time `t`.
+    /// forces at time `t`. Returns whether every open contact's values can be accumulated
+    /// ([`ContactState::accumulable`]: for an open contact, its penetration squared is at
+    /// most a quarter of the bound), checked here where the penetration is at hand.
     #[inline(always)]
-    pub(super) fn detect<K: Lanes>(&mut self, t: f64, predicted: bool) {
+    pub(super) fn detect<K: Lanes>(&mut self, t: f64, predicted: bool) -> bool {
         let velocity = if predicted {
             &self.cd.qd_star
         } else {
@@ -75,6 +72,8 @@ impl Simulation<'_> {
         let p = self.cd.q.len();
         let penalty = matches!(self.tangential, Tangential::Penalty { .. });
         self.closed.clear();
+        let quarter_bound = 0.25 * self.accumulation_bound;
+        let mut open_within = true;
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
             state.tangential_force = Vector2::zeros();
             state.held = false;
@@ -92,6 +91,9 @@ impl Simulation<'_> {
             state.closed = state.frame.penetration > 0.0;
             if !state.closed {
                 state.normal_force = 0.0;
+                // no forces, no velocity: `accumulable` reduces to this (a NaN fails it)
+                let d = state.frame.penetration;
+                open_within &= d * d <= quarter_bound;
                 continue;
             }
             self.closed.push(k);
@@ -122,6 +124,7 @@ impl Simulation<'_> {
                 state.x_relative = pt.coords + recombine(rows, &self.cd.q) - d;
             }
         }
+        open_within
     }
 
     /// Full-step velocities of the closed contacts (of all when `all`) relative to their

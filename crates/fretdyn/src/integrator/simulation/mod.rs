@@ -195,6 +195,8 @@ pub struct Simulation<'m> {
     fluid: Option<FluidElasticForce>,
     /// Modal loads `Φ_lᵀ F_l`, one row of p per load.
     load_rows: Vec<f64>,
+    /// The time history of each row of `load_rows`, in order.
+    load_histories: Vec<&'m crate::loads::TimeHistory>,
     /// Signal generators of the turbulent loads, one per load.
     turbulence: Vec<crate::loads::turbulence::RandomChannels>,
     /// Work space: the turbulence signals at the current time.
@@ -564,6 +566,10 @@ impl<'m> Simulation<'m> {
             frame_rows,
             fluid,
             load_rows,
+            load_histories: (model.loads.iter().map(|l| &l.history))
+                .chain(model.modal_loads.iter().map(|l| &l.history))
+                .chain(model.base_acceleration.iter().map(|b| &b.history))
+                .collect(),
             turbulence,
             signals: vec![0.0; channels],
             external: vec![0.0; p],
@@ -589,11 +595,15 @@ impl<'m> Simulation<'m> {
 
     /// t = 0: contacts at the initial state, initial acceleration, first sample.
     fn start(&mut self) {
-        self.external_force(0.0);
+        self.external_force::<Portable>(0.0);
         self.fluid_elastic_force::<Portable>(0, false);
-        self.detect::<Portable>(0.0, false);
-        self.contact_forces();
-        self.cd.start(&self.force);
+        let _ = self.detect::<Portable>(0.0, false);
+        self.contact_forces::<Portable>();
+        self.cd.start(normal::modal_force(
+            &self.closed,
+            &self.external,
+            &self.force,
+        ));
         self.full_step_velocities::<Portable>(true);
         for c in &mut self.contacts {
             // the velocities were the initial (full-step) ones already
@@ -664,13 +674,17 @@ impl<'m> Simulation<'m> {
         self.step += 1;
         let t = self.step as f64 * self.settings.dt;
         self.cd.predict_with::<K>();
-        self.external_force(t);
+        self.external_force::<K>(t);
         if self.fluid.is_some() {
             self.fluid_elastic_force::<K>(self.step, true);
         }
-        self.detect::<K>(t, true);
-        self.contact_forces();
-        self.cd.free_acceleration_with::<K>(&self.force);
+        let open_within = self.detect::<K>(t, true);
+        self.contact_forces::<K>();
+        self.cd.free_acceleration_with::<K>(normal::modal_force(
+            &self.closed,
+            &self.external,
+            &self.force,
+        ));
         self.lagrange::<K>();
         let modal = self.cd.correct_with::<K>(&self.external);
         self.full_step_velocities::<K>(false);
@@ -683,8 +697,11 @@ impl<'m> Simulation<'m> {
             time: t,
             contact,
         };
-        if let Some(k) = self.contacts.iter().position(|c| !c.accumulable(bound)) {
-            return Err(diverged(Some(k)));
+        // the open contacts were checked by detection, the closed ones are checked here
+        let closed = &self.closed;
+        if !(open_within && closed.iter().all(|&k| self.contacts[k].accumulable(bound))) {
+            let first = self.contacts.iter().position(|c| !c.accumulable(bound));
+            return Err(diverged(first));
         }
         let (e, powers) = self.energy_and_powers(modal);
         let magnitude = e.abs() + powers.iter().map(|p| p.abs()).sum::<f64>();
@@ -708,7 +725,7 @@ impl<'m> Simulation<'m> {
             .zip(&self.frame_rows)
             .map(|((s, c), rows)| step_values(s, c, rows.as_ref(), t));
         self.statistics
-            .step(&self.settings.statistics, &self.names, t, dt, values);
+            .step(&self.settings.statistics, t, dt, values);
         if let Some(map) = &mut self.wear_map {
             track_wear(
                 map,

@@ -2,12 +2,14 @@
 //! contacts, with the penalty tangential law (THEORY §2 step 4, §4.1).
 
 use super::{Simulation, Tangential, contact_rows, contact_states};
+use crate::kernels::Lanes;
 use crate::structure::modal::project_add;
 
 impl Simulation<'_> {
-    /// Step 4 (and the penalty tangential forces): modal force `f = f_ext + Σ Φ_cᵀ R_c`.
+    /// Step 4 (and the penalty tangential forces): modal force `f = f_ext + Σ Φ_cᵀ R_c`,
+    /// formed only when a contact is closed ([`modal_force`] is `f_ext` otherwise).
     #[inline(always)]
-    pub(super) fn contact_forces(&mut self) {
+    pub(super) fn contact_forces<K: Lanes>(&mut self) {
         if let Tangential::Penalty { settings, contacts } = &mut self.tangential {
             for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
                 if state.closed {
@@ -26,11 +28,14 @@ impl Simulation<'_> {
                 }
             }
         }
+        if self.closed.is_empty() {
+            return;
+        }
         self.force.copy_from_slice(&self.external);
         for &k in &self.closed {
             let state = &self.contacts[k];
             match &self.frame_rows[k] {
-                Some(rows) => rows.project_add(
+                Some(rows) => rows.project_add::<K>(
                     &state.frame.normal,
                     state.normal_force,
                     &state.tangential_force,
@@ -44,4 +49,15 @@ impl Simulation<'_> {
             }
         }
     }
+}
+
+/// The modal force of the step: the external force when no contact is closed, else the one
+/// [`Simulation::contact_forces`] formed.
+#[inline(always)]
+pub(super) fn modal_force<'a>(
+    closed: &[usize],
+    external: &'a [f64],
+    force: &'a [f64],
+) -> &'a [f64] {
+    if closed.is_empty() { external } else { force }
 }

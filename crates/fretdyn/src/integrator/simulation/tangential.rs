@@ -113,7 +113,7 @@ impl Simulation<'_> {
         let residual =
             residual.unwrap_or_else(|| problem.natural_map_residual(&lambda[..m], &slide[..m]));
         self.solver_stats.add_residual(residual);
-        problem.apply(&lambda[..m], &mut self.cd.qdd);
+        problem.apply::<K>(&lambda[..m], &mut self.cd.qdd);
         for (k, slot) in problem.slots().iter().enumerate() {
             // held: both half-step velocities of q̇_{n+1} imposed (only this step's with the
             // full-step constraint)
