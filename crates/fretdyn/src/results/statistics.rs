@@ -183,7 +183,52 @@ pub struct StepValues {
     pub direction: [f64; 2],
 }
 
+/// One contact's step as [`ContactStatisticsState::step`] takes it: an open contact's offset
+/// and penetration (its forces and slip are zero, its angle unused), or a closed contact's
+/// values. Most contacts are open at most steps: they cost these two numbers.
+#[derive(Debug, Clone, Copy)]
+pub enum ContactStep {
+    /// Open at the end of the step: [`StepValues::radial`] and [`StepValues::penetration`].
+    Open {
+        /// The offset ([`StepValues::radial`]), m.
+        radial: f64,
+        /// The penetration, negative ([`StepValues::penetration`]), m.
+        penetration: f64,
+    },
+    /// Closed at the end of the step.
+    Closed(StepValues),
+}
+
+impl From<StepValues> for ContactStep {
+    fn from(v: StepValues) -> Self {
+        if v.closed {
+            ContactStep::Closed(v)
+        } else {
+            ContactStep::Open {
+                radial: v.radial,
+                penetration: v.penetration,
+            }
+        }
+    }
+}
+
 impl StepValues {
+    /// The values of an open contact at `t` (what [`ContactStep::Open`] stands for).
+    fn open(t: f64, radial: f64, penetration: f64) -> Self {
+        StepValues {
+            t,
+            closed: false,
+            stick: true,
+            normal: 0.0,
+            tangential: 0.0,
+            slip_speed: 0.0,
+            friction_power: 0.0,
+            penetration,
+            radial,
+            direction: [1.0, 0.0],
+        }
+    }
+
     /// The angle `θ` of [`StepValues::direction`], degrees in (−180, 180].
     fn angle_deg(&self) -> f64 {
         self.direction[1].atan2(self.direction[0]).to_degrees()
@@ -235,20 +280,13 @@ struct ImpactTracker {
 }
 
 impl ImpactTracker {
-    /// Whether [`Self::step`] has anything to do beyond remembering the penetration: the
-    /// contact is closed, or an impact is in progress (an open contact with none only moves
-    /// [`Self::idle`]'s two values along).
+    /// [`Self::step`] of an open contact with no impact in progress (`active` false): it
+    /// neither starts nor ends one, and only its penetration and time are kept for the next
+    /// crossing.
     #[inline]
-    fn busy(&self, v: &StepValues) -> bool {
-        v.closed || self.active
-    }
-
-    /// [`Self::step`] of an open contact with no impact in progress: it neither starts nor
-    /// ends one, and only its penetration and time are kept for the next crossing.
-    #[inline]
-    fn idle(&mut self, v: &StepValues) {
-        self.previous_penetration = v.penetration;
-        self.previous_t = v.t;
+    fn idle(&mut self, t: f64, penetration: f64) {
+        self.previous_penetration = penetration;
+        self.previous_t = t;
     }
 
     /// Zero crossing of the penetration between the previous step and this one.
@@ -443,14 +481,20 @@ impl ContactAccumulator {
     /// step), so that the extrema, started at `±∞`, take the first value exactly.
     #[inline]
     fn add_step(&mut self, v: &StepValues, dt: f64) {
-        self.radial_sum += v.radial;
-        self.radial_sq_sum += v.radial * v.radial;
-        self.radial_min = smaller(self.radial_min, v.radial);
-        self.radial_max = larger(self.radial_max, v.radial);
-        self.penetration_max = larger(self.penetration_max, v.penetration);
+        self.add_offset(v.radial, v.penetration);
         if v.closed {
             self.add_closed_step(v, dt);
         }
+    }
+
+    /// The sums of every step, open or closed: the offset's, and the largest penetration.
+    #[inline(always)]
+    fn add_offset(&mut self, radial: f64, penetration: f64) {
+        self.radial_sum += radial;
+        self.radial_sq_sum += radial * radial;
+        self.radial_min = smaller(self.radial_min, radial);
+        self.radial_max = larger(self.radial_max, radial);
+        self.penetration_max = larger(self.penetration_max, penetration);
     }
 
     /// The sums of a closed step.
@@ -1122,7 +1166,7 @@ impl ContactStatisticsState {
         settings: &StatisticsSettings,
         t: f64,
         dt: f64,
-        values: impl Iterator<Item = StepValues>,
+        values: impl Iterator<Item = ContactStep>,
     ) {
         let in_window = settings.step_in_window(t, dt);
         self.block_steps += in_window as u64;
@@ -1133,15 +1177,30 @@ impl ContactStatisticsState {
             impacts,
             ..
         } = self;
-        for (k, ((v, tracker), block)) in values.zip(trackers.iter_mut()).zip(block).enumerate() {
+        for (k, ((input, tracker), block)) in values.zip(trackers.iter_mut()).zip(block).enumerate()
+        {
             // the sums and the impacts' counts are apart: their order does not matter
-            if in_window {
-                block.add_step(&v, dt);
-            }
-            if tracker.busy(&v) {
-                impact_step(k, v, rest, in_window, tracker, block, impacts);
-            } else {
-                tracker.idle(&v);
+            match input {
+                ContactStep::Open {
+                    radial,
+                    penetration,
+                } => {
+                    if in_window {
+                        block.add_offset(radial, penetration);
+                    }
+                    if tracker.active {
+                        let v = StepValues::open(t, radial, penetration);
+                        impact_step(k, v, rest, in_window, tracker, block, impacts);
+                    } else {
+                        tracker.idle(t, penetration);
+                    }
+                }
+                ContactStep::Closed(v) => {
+                    if in_window {
+                        block.add_step(&v, dt);
+                    }
+                    impact_step(k, v, rest, in_window, tracker, block, impacts);
+                }
             }
         }
         if in_window && t >= self.close_from {
@@ -1338,7 +1397,7 @@ mod tests {
     ) {
         for n in from + 1..=to {
             let t = n as f64 * DT;
-            state.step(settings, t, DT, (0..CONTACTS).map(|k| values(k, n)));
+            state.step(settings, t, DT, (0..CONTACTS).map(|k| values(k, n).into()));
         }
     }
 

@@ -5,7 +5,7 @@ use super::{ContactState, RunResults, Simulation, Termination};
 use crate::contact::frame_rows::FrameRows;
 use crate::contact::friction::Slide;
 use crate::results::recorder::{ContactSample, Recorder};
-use crate::results::statistics::StepValues;
+use crate::results::statistics::{ContactStep, StepValues};
 use crate::structure::modal::recombine;
 
 impl Simulation<'_> {
@@ -146,15 +146,35 @@ impl Simulation<'_> {
     }
 }
 
-/// One contact's values of the step ending at `t`, for the statistics (THEORY §5).
+/// One contact's step ending at `t` for the statistics (THEORY §5): an open contact's offset
+/// and penetration, or a closed one's [`step_values`].
 #[inline(always)]
-pub(super) fn step_values(
+pub(super) fn contact_step(
     s: &ContactState,
     c: &crate::contact::Contact,
     rows: Option<&FrameRows>,
     t: f64,
-) -> StepValues {
-    let (radial, direction) = if rows.is_some() {
+) -> ContactStep {
+    if s.closed {
+        ContactStep::Closed(step_values(s, c, rows, t))
+    } else {
+        ContactStep::Open {
+            radial: offset(s, c, rows, t).0,
+            penetration: s.frame.penetration,
+        }
+    }
+}
+
+/// The offset of contact `s` and its direction ([`StepValues::radial`],
+/// [`StepValues::direction`]).
+#[inline(always)]
+fn offset(
+    s: &ContactState,
+    c: &crate::contact::Contact,
+    rows: Option<&FrameRows>,
+    t: f64,
+) -> (f64, [f64; 2]) {
+    if rows.is_some() {
         // a plane or bars: the distance from the (mid-)plane, THEORY §5
         (s.distance, [1.0, 0.0])
     } else if c.obstacle.is_hole() {
@@ -168,7 +188,18 @@ pub(super) fn step_values(
         (r, unit)
     } else {
         (c.local(&s.x, t).x, [1.0, 0.0])
-    };
+    }
+}
+
+/// One contact's values of the step ending at `t`, for the statistics (THEORY §5).
+#[inline(always)]
+pub(super) fn step_values(
+    s: &ContactState,
+    c: &crate::contact::Contact,
+    rows: Option<&FrameRows>,
+    t: f64,
+) -> StepValues {
+    let (radial, direction) = offset(s, c, rows, t);
     let (slip_speed, friction_power, tangential) = if s.closed {
         let vt = s.tangential_velocity();
         (

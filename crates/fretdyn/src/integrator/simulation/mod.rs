@@ -23,7 +23,7 @@ mod tangential;
 pub use run::{Divergence, Progress, RunResults, Termination, run, simulate};
 pub use settings::RunSettings;
 
-use bookkeeping::step_values;
+use bookkeeping::{contact_step, step_values};
 use settings::round_down;
 use tangential::{LagrangeSolver, Tangential};
 
@@ -723,7 +723,7 @@ impl<'m> Simulation<'m> {
             .iter()
             .zip(&model.contacts)
             .zip(&self.frame_rows)
-            .map(|((s, c), rows)| step_values(s, c, rows.as_ref(), t));
+            .map(|((s, c), rows)| contact_step(s, c, rows.as_ref(), t));
         self.statistics
             .step(&self.settings.statistics, t, dt, values);
         if let Some(map) = &mut self.wear_map {
