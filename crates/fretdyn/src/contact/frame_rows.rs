@@ -138,7 +138,9 @@ impl FrameRows {
         qd: &[f64],
         obstacle: &Vector3<f64>,
     ) -> Vector2<f64> {
-        Vector2::new(K::dot(self.row(1), qd), K::dot(self.row(2), qd))
+        // one pass over q̇ for both rows (a·b = b·a bit for bit: the same sums as two dots)
+        let (t1, t2) = K::dot2(qd, self.row(1), self.row(2));
+        Vector2::new(t1, t2)
             - Vector2::new(
                 self.tangents[0].dot(obstacle),
                 self.tangents[1].dot(obstacle),
