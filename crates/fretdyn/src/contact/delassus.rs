@@ -397,6 +397,20 @@ impl TangentialProblem {
         slide: &[Slide],
     ) -> f64 {
         let m = self.slots.len().min(lambda.len());
+        if m == 1 {
+            // a single contact (the common case), without the loops: the same operations
+            let [c, _] = self.sweep[0].get();
+            let block = self.diagonal_block(0);
+            let slot = &self.slots[0];
+            let (r2, l2) = slot_residual(
+                lambda[0],
+                c - block.h * lambda[0],
+                block.rho(),
+                slot,
+                slide[0],
+            );
+            return relative_residual(0.0 + r2, 0.0 + l2, 0.0f64.max(slot.s_static));
+        }
         self.natural_map(lambda, slide, |k| {
             let [c, _] = self.sweep[k].get();
             let mut w = c - self.diagonal_block(k).h * lambda[k];
@@ -419,20 +433,18 @@ impl TangentialProblem {
         let mut l2 = 0.0;
         let mut s_max = 0.0f64;
         for (k, slot) in self.slots.iter().enumerate() {
-            let rho = self.diagonal_block(k).rho();
-            let s = match slide[k] {
-                Slide::Stick => slot.s_static,
-                Slide::Slip => slot.s_dynamic,
-            };
-            let z = lambda[k] + w(k) * rho;
-            let n2 = z.norm_squared();
-            let projected = if n2 > s * s { z * (s / n2.sqrt()) } else { z };
-            r2 += (lambda[k] - projected).norm_squared();
-            l2 += lambda[k].norm_squared();
+            let (r, l) = slot_residual(
+                lambda[k],
+                w(k),
+                self.diagonal_block(k).rho(),
+                slot,
+                slide[k],
+            );
+            r2 += r;
+            l2 += l;
             s_max = s_max.max(slot.s_static);
         }
-        let scale = l2.sqrt().max(s_max);
-        if scale > 0.0 { r2.sqrt() / scale } else { 0.0 }
+        relative_residual(r2, l2, s_max)
     }
 
     /// `q̈ −= A⁻¹ Lᵀ λ`, row by row with the kernels `K` (`q̈ += (−λ_r) (A⁻¹Lᵀ)_r`: the
@@ -617,6 +629,33 @@ fn cholesky_solve(a: &mut [f64], diag: &[f64], x: &mut [f64], n: usize, tiny: f6
         x[i] = s / a[i * n + i];
     }
     regularised
+}
+
+/// One slot's terms of the natural-map residual ([`TangentialProblem::natural_map_residual`]):
+/// `(|λ − proj_{disk(s)}(λ + ρ w)|², |λ|²)` for its `λ`, residual velocity `w`, `ρ` and status.
+#[inline(always)]
+fn slot_residual(
+    lambda: Vector2<f64>,
+    w: Vector2<f64>,
+    rho: f64,
+    slot: &Slot,
+    slide: Slide,
+) -> (f64, f64) {
+    let s = match slide {
+        Slide::Stick => slot.s_static,
+        Slide::Slip => slot.s_dynamic,
+    };
+    let z = lambda + w * rho;
+    let n2 = z.norm_squared();
+    let projected = if n2 > s * s { z * (s / n2.sqrt()) } else { z };
+    ((lambda - projected).norm_squared(), lambda.norm_squared())
+}
+
+/// `‖r‖ / max(‖λ‖, max_i s_i)` from the sums of squares (0 when both are 0).
+#[inline(always)]
+fn relative_residual(r2: f64, l2: f64, s_max: f64) -> f64 {
+    let scale = l2.sqrt().max(s_max);
+    if scale > 0.0 { r2.sqrt() / scale } else { 0.0 }
 }
 
 #[cfg(test)]

@@ -53,15 +53,28 @@ pub struct Sine {
 }
 
 impl TimeHistory {
-    /// Value at time `t`.
-    #[inline]
+    /// Value at time `t`. A harmonic history, the common one, is formed in line (the time
+    /// step calls this for every load at every step); the others through a call.
+    #[inline(always)]
     pub fn value(&self, t: f64) -> f64 {
+        match *self {
+            TimeHistory::Harmonic {
+                frequency_hz,
+                phase,
+            } => harmonic(frequency_hz, phase, t),
+            _ => self.value_by_call(t),
+        }
+    }
+
+    /// [`Self::value`] of any history, out of line.
+    #[inline(never)]
+    fn value_by_call(&self, t: f64) -> f64 {
         match *self {
             TimeHistory::Constant => 1.0,
             TimeHistory::Harmonic {
                 frequency_hz,
                 phase,
-            } => (std::f64::consts::TAU * frequency_hz * t + phase).sin(),
+            } => harmonic(frequency_hz, phase, t),
             TimeHistory::Sines(ref terms) => terms
                 .iter()
                 .map(|s| s.amplitude * (std::f64::consts::TAU * s.frequency_hz * t + s.phase).sin())
@@ -101,6 +114,12 @@ impl TimeHistory {
             TimeHistory::Table { times, values } => check_table(times, values, field),
         }
     }
+}
+
+/// `sin(2π f t + φ)`.
+#[inline(always)]
+fn harmonic(frequency_hz: f64, phase: f64, t: f64) -> f64 {
+    (std::f64::consts::TAU * frequency_hz * t + phase).sin()
 }
 
 /// Linear interpolation in a table (strictly increasing `times`), held at the ends.
