@@ -5,7 +5,9 @@
 # here as side_by_side.sh builds it) on case S1, for the four tangential methods, interleaved
 # C, old, new, C, old, new, ... REPS times (default 5) per method. Each program's own time-loop
 # steps/s (fretdyn: summary.json performance.steps_per_second). Prints a markdown table of the
-# medians (min–max) and of the median per-triple ratios old/C and new/C.
+# medians (min–max) and of the median per-triple ratios old/C and new/C, then the ratios of
+# the best runs (max steps/s of each program over the REPS runs: the run least disturbed by
+# whatever else shares the machine; steadier than the medians on a noisy machine).
 #   bash scripts/before_after.sh /tmp/old/target/release/fretdyn target/release/fretdyn 5
 set -euo pipefail
 OLD=$(realpath "${1:?usage: before_after.sh OLD NEW [REPS] [PERF_DIR]}")
@@ -42,4 +44,10 @@ for m in dict.fromkeys(r[0] for r in rows):
     med = lambda x: f"{st.median(x):.3g} ({min(x):.3g}–{max(x):.3g})"
     rat = lambda a, b: f"{st.median([x / y for x, y in zip(a, b)]):.3f}"
     print(f"| {m} | {med(c)} | {med(o)} | {med(n)} | {rat(o, c)} | {rat(n, c)} | {rat(n, o)} |")
+print()
+print("| S1, method | best C steps/s | best before | best after | before/C | after/C | after/before |")
+print("|---|---|---|---|---|---|---|")
+for m in dict.fromkeys(r[0] for r in rows):
+    c, o, n = (max(float(r[k]) for r in rows if r[0] == m) for k in (1, 2, 3))
+    print(f"| {m} | {c:.3g} | {o:.3g} | {n:.3g} | {o / c:.3f} | {n / c:.3f} | {n / o:.3f} |")
 PY

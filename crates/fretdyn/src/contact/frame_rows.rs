@@ -28,6 +28,9 @@ pub struct FrameRows {
     /// `[n·Φ_c, t₁·Φ_c, t₂·Φ_c]`, p values each; `n` is the obstacle's normal as declared
     /// (for bars, the normal of the side reached at `s < 0`).
     rows: Vec<f64>,
+    /// The number of modes `p` (a third of `rows`, kept: detection slices a row per contact
+    /// per step).
+    p: usize,
     normal: Vector3<f64>,
     tangents: [Vector3<f64>; 2],
     /// `(x_c − x₀)·n`.
@@ -67,6 +70,7 @@ impl FrameRows {
         }
         Some(Self {
             rows,
+            p,
             normal,
             tangents,
             offset: (point.coords - origin).dot(&normal),
@@ -83,7 +87,7 @@ impl FrameRows {
 
     #[inline(always)]
     fn p(&self) -> usize {
-        self.rows.len() / 3
+        self.p
     }
 
     /// The row `n·Φ_c` (`a = 0`) or `t_a·Φ_c` (`a = 1, 2`).

@@ -77,13 +77,13 @@ impl Simulation<'_> {
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
             state.tangential_force = Vector2::zeros();
             state.held = false;
-            let pt = &self.model.basis.points[c.point];
             match &self.frame_rows[k] {
                 Some(rows) => {
                     state.distance = rows.distance::<K>(&self.cd.q, &c.motion, t);
                     rows.update(state.distance, &mut state.frame);
                 }
                 None => {
+                    let pt = &self.model.basis.points[c.point];
                     state.x = pt.coords + recombine(&pt.rows, &self.cd.q);
                     state.frame = c.frame(&state.x, t);
                 }
@@ -97,6 +97,7 @@ impl Simulation<'_> {
                 continue;
             }
             self.closed.push(k);
+            let pt = &self.model.basis.points[c.point];
             // an open contact's velocity is only needed at output samples
             if !c.motion.is_fixed() {
                 state.frame.velocity = c.motion.at(t).1;
