@@ -65,7 +65,8 @@ impl EnergyBalance {
         self.last_powers = powers;
         self.last = e;
         let residual = self.residual();
-        self.max_abs = self.max_abs.max(residual.abs());
+        // the running maximum starts at 0 and skips a NaN residual
+        self.max_abs = crate::kernels::running_max(self.max_abs, residual.abs());
         self.scale = self
             .scale
             .max(e.abs())

@@ -228,11 +228,12 @@ impl StepValues {
             direction: [1.0, 0.0],
         }
     }
+}
 
-    /// The angle `θ` of [`StepValues::direction`], degrees in (−180, 180].
-    fn angle_deg(&self) -> f64 {
-        self.direction[1].atan2(self.direction[0]).to_degrees()
-    }
+/// The angle `θ` of a direction `(cos θ, sin θ)` ([`StepValues::direction`]), degrees in
+/// (−180, 180].
+fn angle_deg(direction: [f64; 2]) -> f64 {
+    direction[1].atan2(direction[0]).to_degrees()
 }
 
 /// A finished impact (per-impact table).
@@ -277,6 +278,9 @@ struct ImpactTracker {
     /// The current impact started in a step of the window: it is counted in the window's
     /// impacts, and its row and duration go to the window's table when it ends.
     in_window: bool,
+    /// [`StepValues::direction`] at the current impact's peak: its angle
+    /// ([`Impact::angle_deg`]) is formed when the impact ends ([`Self::end`]).
+    peak_direction: [f64; 2],
 }
 
 impl ImpactTracker {
@@ -300,8 +304,53 @@ impl ImpactTracker {
     }
 
     /// One step, `in_window` when it counts in the window; returns `(started, finished
-    /// impact)` (whether that impact started in the window is [`Self::in_window`]).
+    /// impact)` (whether that impact started in the window is [`Self::in_window`]). The
+    /// common step of a closed contact, within its impact and not reclosing, in line; the
+    /// others by [`Self::step_in_general`].
+    #[inline(always)]
     fn step(
+        &mut self,
+        contact: usize,
+        v: &StepValues,
+        rest: f64,
+        in_window: bool,
+    ) -> (bool, Option<Impact>) {
+        if v.closed && self.active && !self.open {
+            if let Some(imp) = &mut self.current {
+                let dt = v.t - self.previous_t;
+                Self::add_closed(imp, &mut self.peak_direction, v, dt);
+                self.previous_penetration = v.penetration;
+                self.previous_t = v.t;
+                return (false, None);
+            }
+        }
+        self.step_in_general(contact, v, rest, in_window)
+    }
+
+    /// A closed step of impact `imp` (of `dt`, its values `v`): its impulse, its contact
+    /// time and its peak.
+    #[inline(always)]
+    fn add_closed(imp: &mut Impact, peak_direction: &mut [f64; 2], v: &StepValues, dt: f64) {
+        imp.impulse += v.normal * dt;
+        imp.contact_time += dt;
+        if v.normal > imp.peak_force {
+            imp.peak_force = v.normal;
+            imp.peak_time = v.t;
+            *peak_direction = v.direction;
+        }
+    }
+
+    /// The current impact, ended: its angle at the peak formed.
+    fn end(&mut self) -> Option<Impact> {
+        self.current.take().map(|mut imp| {
+            imp.angle_deg = angle_deg(self.peak_direction);
+            imp
+        })
+    }
+
+    /// [`Self::step`], every case.
+    #[inline(never)]
+    fn step_in_general(
         &mut self,
         contact: usize,
         v: &StepValues,
@@ -335,18 +384,13 @@ impl ImpactTracker {
                         impulse: 0.0,
                         rebound_speed: 0.0,
                         rebounds: 0,
-                        angle_deg: v.angle_deg(),
+                        angle_deg: 0.0,
                     });
+                    self.peak_direction = v.direction;
                 }
             }
             if let Some(imp) = &mut self.current {
-                imp.impulse += v.normal * dt;
-                imp.contact_time += dt;
-                if v.normal > imp.peak_force {
-                    imp.peak_force = v.normal;
-                    imp.peak_time = v.t;
-                    imp.angle_deg = v.angle_deg();
-                }
+                Self::add_closed(imp, &mut self.peak_direction, v, dt);
             }
         } else if self.active {
             if !self.open {
@@ -359,7 +403,7 @@ impl ImpactTracker {
             if v.t - self.last_opening > rest {
                 self.active = false;
                 self.open = false;
-                if let Some(mut imp) = self.current.take() {
+                if let Some(mut imp) = self.end() {
                     imp.duration = self.last_opening - imp.start;
                     finished = Some(imp);
                 }
@@ -379,18 +423,17 @@ pub const PEAK_BINS_PER_DECADE: usize = 10;
 const PEAK_MIN_DECADE: i32 = -6;
 const PEAK_DECADES: usize = 15;
 
-/// `min(m, x)` for a running minimum `m` that is never NaN (a NaN `x` is skipped).
-/// `f64::min`, not `if x < m { x } else { m }`: the compiler turns that select, written back
-/// to `m`, into a conditional (masked) store, microcoded on some processors.
+/// `min(m, x)` for a running minimum `m` that is never NaN (a NaN `x` is skipped):
+/// [`crate::kernels::running_min`].
 #[inline(always)]
 fn smaller(m: f64, x: f64) -> f64 {
-    m.min(x)
+    crate::kernels::running_min(m, x)
 }
 
 /// `max(m, x)` for a running maximum `m` that is never NaN, as [`smaller`].
 #[inline(always)]
 fn larger(m: f64, x: f64) -> f64 {
-    m.max(x)
+    crate::kernels::running_max(m, x)
 }
 
 /// Running sums of one contact over a window or a block. The number of steps is the same for
@@ -508,10 +551,10 @@ impl ContactAccumulator {
         }
         self.normal_sum += v.normal;
         self.normal_sq_sum += v.normal * v.normal;
-        self.normal_max = self.normal_max.max(v.normal);
+        self.normal_max = larger(self.normal_max, v.normal);
         self.tangential_sum += v.tangential;
         self.tangential_sq_sum += v.tangential * v.tangential;
-        self.tangential_max = self.tangential_max.max(v.tangential);
+        self.tangential_max = larger(self.tangential_max, v.tangential);
         self.wear_work += v.friction_power * dt;
         self.normal_wear_work += v.normal * v.slip_speed * dt;
         self.angle_cos += v.direction[0];
@@ -1285,7 +1328,7 @@ impl ContactStatisticsState {
         dt: f64,
     ) -> Vec<ContactStatistics> {
         for (k, tr) in self.trackers.iter_mut().enumerate() {
-            if let Some(mut imp) = tr.current.take() {
+            if let Some(mut imp) = tr.end() {
                 let end = if tr.open {
                     tr.last_opening
                 } else {
@@ -1323,9 +1366,10 @@ impl ContactStatisticsState {
     }
 }
 
-/// The step of contact `k` when it is closed or in an impact ([`ImpactTracker::busy`]): the
+/// The step of contact `k` when it is closed or in an impact (its tracker active): the
 /// tracker's step, then an impact that starts in a step of the window counts in the block,
 /// and one that ends, having started in the window, is added to it and to the table.
+#[inline(always)]
 fn impact_step(
     k: usize,
     v: StepValues,

@@ -134,8 +134,9 @@ pub const CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNC";
 
 /// Format version of `checkpoint.bin` (1 was bincode, without a header; 2 counted the
 /// statistics' steps per contact and accumulated blocks when there were none; 4 had blocks
-/// only when set, and no batch moments).
-pub const CHECKPOINT_FORMAT: u32 = 5;
+/// only when set, and no batch moments; 5 had the angle of an impact's peak formed at the
+/// peak, not its direction).
+pub const CHECKPOINT_FORMAT: u32 = 6;
 
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {

@@ -26,11 +26,15 @@ impl Simulation<'_> {
         match self.load_histories.split_first() {
             Some((first, others)) => {
                 K::scale(&mut self.external, first.value(t), &self.load_rows[..p]);
-                for (history, row) in others
-                    .iter()
-                    .zip(self.load_rows[p..].chunks_exact(p.max(1)))
-                {
-                    K::axpy(&mut self.external, history.value(t), row);
+                // (one load, the common case, skips the set-up of the loop: its rows' count
+                // is a division)
+                if !others.is_empty() {
+                    for (history, row) in others
+                        .iter()
+                        .zip(self.load_rows[p..].chunks_exact(p.max(1)))
+                    {
+                        K::axpy(&mut self.external, history.value(t), row);
+                    }
                 }
             }
             None => self.external.fill(0.0),
