@@ -64,6 +64,9 @@ pub struct TangentialProblem {
     /// only, and its answer ([`Self::is_singular`]).
     singular_for: Vec<usize>,
     singular: Option<bool>,
+    /// The closed contacts whose `H`, made of fixed rows only, is in `h` (empty: none):
+    /// [`Self::assemble`] gathers it again only when they change.
+    h_for: Vec<usize>,
     /// Whether the local solves are exact ([`Self::set_exact_local_solve`]).
     exact: bool,
 }
@@ -89,6 +92,7 @@ impl TangentialProblem {
             stride: rows,
             singular_for: Vec::with_capacity(contacts),
             singular: None,
+            h_for: Vec::with_capacity(contacts),
             exact: true,
         }
     }
@@ -105,6 +109,7 @@ impl TangentialProblem {
     ) {
         self.fixed[contact] = false;
         self.singular = None;
+        self.h_for.clear();
         self.compute_rows(contact, tangents, rows, apply_a_inv);
         self.fixed[contact] = true;
         let p = self.p;
@@ -242,11 +247,22 @@ impl TangentialProblem {
         let m = self.slots.len();
         let st = self.stride;
         let inverse_theta_dt = 1.0 / theta_dt;
+        // H of fixed rows depends only on which contacts are closed: the one in `h` serves
+        // while they stay the same (a contact stays closed for many steps)
+        let all_fixed = self.slots.iter().all(|s| self.fixed[s.contact]);
+        let h_kept = all_fixed
+            && self.h_for.len() == m
+            && (self.h_for.iter().zip(&self.slots)).all(|(c, s)| *c == s.contact);
+        self.h_for.clear();
+        if all_fixed {
+            self.h_for.extend(self.slots.iter().map(|s| s.contact));
+        }
         for k in 0..m {
             let ck = self.slots[k].contact;
             let fixed_k = self.fixed[ck];
-            // the 2 × 2 blocks H_kl, l ≥ k, and their transposes
-            for l in k..m {
+            // the 2 × 2 blocks H_kl, l ≥ k, and their transposes (none when kept)
+            let last = if h_kept { k } else { m };
+            for l in k..last {
                 let cl = self.slots[l].contact;
                 if fixed_k && self.fixed[cl] {
                     // gathered whole: h_fixed is exactly symmetric (fix_rows)
