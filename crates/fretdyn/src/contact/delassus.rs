@@ -253,9 +253,11 @@ impl TangentialProblem {
         let h_kept = all_fixed
             && self.h_for.len() == m
             && (self.h_for.iter().zip(&self.slots)).all(|(c, s)| *c == s.contact);
-        self.h_for.clear();
-        if all_fixed {
-            self.h_for.extend(self.slots.iter().map(|s| s.contact));
+        if !h_kept {
+            self.h_for.clear();
+            if all_fixed {
+                self.h_for.extend(self.slots.iter().map(|s| s.contact));
+            }
         }
         for k in 0..m {
             let ck = self.slots[k].contact;
