@@ -39,6 +39,9 @@ impl Simulation<'_> {
             }
             None => self.external.fill(0.0),
         }
+        if self.turbulence.is_empty() {
+            return;
+        }
         for (load, generator) in self.model.turbulence.iter().zip(&mut self.turbulence) {
             let r = generator.channels();
             let xi = &mut self.signals[..r];
