@@ -264,7 +264,10 @@ fn a_checkpoint_of_another_version_is_refused() {
     let bytes = std::fs::read(&path).unwrap();
     let version = env!("CARGO_PKG_VERSION");
     assert_eq!(&bytes[..8], b"FRETDYNC");
-    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 5);
+    assert_eq!(
+        u32::from_le_bytes(bytes[8..12].try_into().unwrap()),
+        stream::CHECKPOINT_FORMAT
+    );
     assert_eq!(bytes[12] as usize, version.len());
     assert_eq!(&bytes[13..13 + version.len()], version.as_bytes());
     let payload = &bytes[13 + version.len()..];
@@ -286,7 +289,7 @@ fn a_checkpoint_of_another_version_is_refused() {
         assert!(err.contains("start the run again"), "{err}");
     };
     refused(
-        with_header(5, "9.9.9"),
+        with_header(stream::CHECKPOINT_FORMAT, "9.9.9"),
         &[
             "written by fretdyn 9.9.9",
             &format!("this is fretdyn {version}"),
@@ -297,12 +300,17 @@ fn a_checkpoint_of_another_version_is_refused() {
     refused(with_header(3, version), &["checkpoint format 3"]);
     // format 4: blocks only when set, no batch moments
     refused(with_header(4, version), &["checkpoint format 4"]);
+    // format 5: the angle of an impact's peak formed at the peak
+    refused(with_header(5, version), &["checkpoint format 5"]);
     // format 1: bincode, starting with its version (1u32) and the fingerprint
     let mut old = 1u32.to_le_bytes().to_vec();
     old.extend_from_slice(&7u64.to_le_bytes());
     old.extend_from_slice(payload);
     refused(old, &["not a checkpoint of this fretdyn"]);
-    refused(with_header(5, version)[..40].to_vec(), &["damaged"]);
+    refused(
+        with_header(stream::CHECKPOINT_FORMAT, version)[..40].to_vec(),
+        &["damaged"],
+    );
     // the checkpoint as written resumes
     std::fs::write(&path, &bytes).unwrap();
     let r = resume(&case, &dir, 7).unwrap();
