@@ -680,6 +680,73 @@ fn relative_residual(r2: f64, l2: f64, s_max: f64) -> f64 {
 mod tests {
     use super::*;
 
+    /// Three contacts with fixed rows (p = 4) and a diagonal `A⁻¹`.
+    fn fixed_problem() -> TangentialProblem {
+        let (p, contacts) = (4, 3);
+        let a_inv = [0.5, 1.5, 2.0, 0.25];
+        let mut problem = TangentialProblem::new(p, contacts);
+        let tangents = [Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.0, 0.6, 0.8)];
+        for c in 0..contacts {
+            let rows: Vec<f64> = (0..3 * p)
+                .map(|i| ((i * 5 + c * 11) % 7) as f64 - 2.5)
+                .collect();
+            problem.fix_rows(c, &tangents, &rows, |l, out| {
+                for i in 0..l.len() {
+                    out[i] = a_inv[i] * l[i];
+                }
+            });
+        }
+        problem
+    }
+
+    fn closed(problem: &mut TangentialProblem, contacts: &[usize]) {
+        problem.clear();
+        for &c in contacts {
+            let slot = Slot {
+                contact: c,
+                s_static: 1.0,
+                s_dynamic: 0.8,
+            };
+            problem.push(slot, &[Vector3::zeros(); 2], &[], &[]);
+        }
+        problem.assemble(&[0.1, -0.2, 0.3, 0.4], &[1.0, 2.0, -1.0, 0.5], 1e-3, |_| {
+            Vector2::zeros()
+        });
+    }
+
+    /// `H` kept from the last step while the same contacts are closed is the `H` a fresh
+    /// problem gathers for them, bit for bit, whatever closed before.
+    #[test]
+    fn a_kept_delassus_matrix_is_the_one_gathered_again() {
+        let mut problem = fixed_problem();
+        for contacts in [
+            &[0, 1][..],
+            &[0, 1],
+            &[1, 2],
+            &[1, 2],
+            &[0, 1, 2],
+            &[0, 1, 2],
+            &[2],
+            &[0, 2],
+            &[0, 2],
+        ] {
+            closed(&mut problem, contacts);
+            let mut fresh = fixed_problem();
+            closed(&mut fresh, contacts);
+            let n = 2 * contacts.len();
+            for r in 0..n {
+                for c in 0..n {
+                    assert_eq!(
+                        problem.h(r, c).to_bits(),
+                        fresh.h(r, c).to_bits(),
+                        "{contacts:?}: H[{r}][{c}]"
+                    );
+                }
+                assert_eq!(problem.b[r].to_bits(), fresh.b[r].to_bits());
+            }
+        }
+    }
+
     #[test]
     fn cholesky_of_a_non_finite_matrix_returns_nan_instead_of_looping() {
         // a NaN pivot fails every shifted factorisation: this looped forever

@@ -1607,6 +1607,29 @@ mod tests {
         }
     }
 
+    /// An impact's peak is its largest normal force over its closed steps, and its angle the
+    /// direction's at that step (formed when the impact ends), for every impact of the run,
+    /// those ended by the run's end included.
+    #[test]
+    fn an_impact_peaks_at_its_largest_force_with_the_angle_of_that_step() {
+        let s = settings(None);
+        let (_, impacts, _) = run(&s);
+        assert!(impacts.len() > 10, "{} impacts", impacts.len());
+        for imp in &impacts {
+            let first = ((imp.start / DT).ceil() as u64).max(1);
+            let last = ((imp.start + imp.duration) / DT).floor() as u64;
+            let peak = (first..=last.min(STEPS))
+                .map(|n| values(imp.contact, n))
+                .filter(|v| v.closed)
+                .reduce(|a, b| if b.normal > a.normal { b } else { a })
+                .expect("an impact has a closed step");
+            assert_eq!(imp.peak_force, peak.normal);
+            assert_eq!(imp.peak_time, peak.t);
+            let expected = peak.direction[1].atan2(peak.direction[0]).to_degrees();
+            assert_eq!(imp.angle_deg.to_bits(), expected.to_bits(), "{imp:?}");
+        }
+    }
+
     /// The window's extrema are those of the values of its steps (by the midpoint rule), and
     /// 0 for a window with no step.
     #[test]
