@@ -250,9 +250,7 @@ impl TangentialProblem {
         // H of fixed rows depends only on which contacts are closed: the one in `h` serves
         // while they stay the same (a contact stays closed for many steps)
         let all_fixed = self.slots.iter().all(|s| self.fixed[s.contact]);
-        let h_kept = all_fixed
-            && self.h_for.len() == m
-            && (self.h_for.iter().zip(&self.slots)).all(|(c, s)| *c == s.contact);
+        let h_kept = all_fixed && same_contacts(&self.h_for, &self.slots);
         if !h_kept {
             self.h_for.clear();
             if all_fixed {
@@ -495,15 +493,7 @@ impl TangentialProblem {
             return false;
         }
         let all_fixed = self.slots.iter().all(|s| self.fixed[s.contact]);
-        if all_fixed
-            && self.singular.is_some()
-            && self.singular_for.len() == self.slots.len()
-            && self
-                .singular_for
-                .iter()
-                .zip(&self.slots)
-                .all(|(c, s)| *c == s.contact)
-        {
+        if all_fixed && self.singular.is_some() && same_contacts(&self.singular_for, &self.slots) {
             return self.singular == Some(true);
         }
         // H = L A⁻¹ Lᵀ has rank at most p: more than p rows of L are dependent, and the
@@ -647,6 +637,13 @@ fn cholesky_solve(a: &mut [f64], diag: &[f64], x: &mut [f64], n: usize, tiny: f6
         x[i] = s / a[i * n + i];
     }
     regularised
+}
+
+/// Whether `contacts` are the contacts of `slots`, in order (a cached `H` or answer still
+/// holds).
+#[inline]
+fn same_contacts(contacts: &[usize], slots: &[Slot]) -> bool {
+    contacts.len() == slots.len() && contacts.iter().zip(slots).all(|(c, s)| *c == s.contact)
 }
 
 /// One slot's terms of the natural-map residual ([`TangentialProblem::natural_map_residual`]):
