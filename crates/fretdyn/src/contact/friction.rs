@@ -255,18 +255,17 @@ fn disk_boundary_solve(
         // The root lies in [|c| − s h_max, |c| − s h_min]; start from |c| minus the mean of
         // s h_k weighted by c's components, exact to first order in s h/t (a fast slip).
         let n2 = c2[0] + c2[1];
-        let first_order = n2.sqrt() - (c2[0] * hs[0] + c2[1] * hs[1]) / n2;
-        let t = lower
-            .max(c.norm() - hs[0].max(hs[1]))
-            .max(0.0)
-            .max(first_order);
+        let norm = n2.sqrt(); // |c|, rotated
+        let first_order = norm - (c2[0] * hs[0] + c2[1] * hs[1]) / n2;
+        let t = lower.max(norm - hs[0].max(hs[1])).max(0.0).max(first_order);
         if t <= lower {
             // on the pole of a singular H: start just above it
-            lower + f64::EPSILON * (c.norm() + hs[0].abs().max(hs[1].abs()))
+            lower + f64::EPSILON * (norm + hs[0].abs().max(hs[1].abs()))
         } else {
             t
         }
     };
+    let mut converged = false;
     for _ in 0..100 {
         // φ = 1/|u| − 1, φ' = Σ u_k²/(s h_k + t) / |u|³, so the Newton step φ/φ' is
         // |u|²(1 − |u|) / Σ u_k²/(s h_k + t). With e_k = s h_k + t, D = e₀e₁,
@@ -296,12 +295,22 @@ fn disk_boundary_solve(
         // error after a step of δ is about δ²/(t − lower): a step below 1e-8 (t − lower)
         // leaves round-off.
         if step.abs() <= 1e-8 * (t - lower) {
+            converged = true;
             break;
         }
     }
     newton.set(t);
-    // u(t) ∥ (c₀ e₁, c₁ e₀) (times 1/D > 0): λ = s u/|u| needs no division by e_k
     let (e0, e1) = (hs[0] + t, hs[1] + t);
+    if converged && e0 > 0.0 && e1 > 0.0 {
+        // At the root |u| = 1 to round-off: λ = s u = s (c₀/e₀, c₁/e₁) in the eigenbasis,
+        // with one division and no square root.
+        let r = s / (e0 * e1);
+        let lambda = q * Vector2::new(cp[0] * e1 * r, cp[1] * e0 * r);
+        if lambda.x.is_finite() && lambda.y.is_finite() {
+            return lambda;
+        }
+    }
+    // u(t) ∥ (c₀ e₁, c₁ e₀) (times 1/D > 0): λ = s u/|u| needs no division by e_k
     let v = q * Vector2::new(cp[0] * e1, cp[1] * e0);
     let n2 = v.norm_squared();
     if n2.is_finite() && n2 > 0.0 && e0 > 0.0 && e1 > 0.0 {

