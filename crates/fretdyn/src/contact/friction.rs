@@ -217,8 +217,9 @@ pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
 /// monotonically, from above its first step lands below it.
 ///
 /// The root lies between `|c| − s h_max` and `|c| − s h_min` (from
-/// `|c| = |(sH + tI)u|`, `|u| = 1`); the start is `|c|` minus the mean of the `s h_k` weighted
-/// by the components of `c`, exact to first order in `s h / t`, kept above the lower bound.
+/// `|c| = |(sH + tI)u|`, `|u| = 1`); the start is the root's expansion in powers of
+/// `s h/|c|` to third order (to first order when the `s h_k` spread over more than 1 % of
+/// `|c|`), kept above the lower bound.
 /// A start above the root (it may be, and the lower bound itself may be by round-off when
 /// `c` lies along the stiff eigenvector of an `H` anisotropic by 10³, a tube sliding round a
 /// hole) costs Newton one step down (an earlier version projected radially when the start
@@ -252,12 +253,24 @@ fn disk_boundary_solve(
     let mut t = if warm > lower {
         warm
     } else {
-        // The root lies in [|c| − s h_max, |c| − s h_min]; start from |c| minus the mean of
-        // s h_k weighted by c's components, exact to first order in s h/t (a fast slip).
+        // The root lies in [|c| − s h_max, |c| − s h_min]; start from its expansion in
+        // powers of s h/|c| (a fast slip): with the weights w_k = c_k²/|c|², the mean
+        // m = Σ w_k s h_k and the central moments μ₂ = w₀w₁Δ², μ₃ = μ₂(w₁ − w₀)Δ of the s h_k
+        // (Δ = s h₀ − s h₁), t = |c| − m + 3μ₂/(2|c|) − 2μ₃/|c|² + O(μ₂²/|c|³): a relative
+        // error below 1e-9 when the spread √μ₂ is below 1 % of |c|, which leaves Newton one
+        // step. A wider spread starts from the first-order term alone.
         let n2 = c2[0] + c2[1];
         let norm = n2.sqrt(); // |c|, rotated
-        let first_order = norm - (c2[0] * hs[0] + c2[1] * hs[1]) / n2;
-        let t = lower.max(norm - hs[0].max(hs[1])).max(0.0).max(first_order);
+        let inverse_n2 = 1.0 / n2;
+        let (w0, w1) = (c2[0] * inverse_n2, c2[1] * inverse_n2);
+        let delta = hs[0] - hs[1];
+        let mu2 = w0 * w1 * delta * delta;
+        let mut expansion = norm - (w0 * hs[0] + w1 * hs[1]);
+        if mu2 <= 1e-4 * n2 {
+            let inverse_norm = norm * inverse_n2;
+            expansion += inverse_norm * (1.5 * mu2 - 2.0 * inverse_norm * mu2 * (w1 - w0) * delta);
+        }
+        let t = lower.max(norm - hs[0].max(hs[1])).max(0.0).max(expansion);
         if t <= lower {
             // on the pole of a singular H: start just above it
             lower + f64::EPSILON * (norm + hs[0].abs().max(hs[1].abs()))

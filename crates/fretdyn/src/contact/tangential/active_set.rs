@@ -98,7 +98,7 @@ impl ActiveSet {
             let h = history[slot.contact];
             if h.closed && h.slide == Slide::Stick {
                 self.stick[k] = true;
-            } else if h.closed && h.direction.norm() > 0.0 {
+            } else if h.closed && h.direction.norm_squared() > 0.0 {
                 self.stick[k] = false;
                 self.direction[k] = h.direction;
             } else {
