@@ -384,7 +384,21 @@ impl TangentialProblem {
     /// of a sliding contact; it is 0 exactly when λ satisfies Coulomb's law. Returned as
     /// `‖r‖ / max(‖λ‖, max_i s_i)`, relative to the friction forces at stake.
     pub fn natural_map_residual(&self, lambda: &[Vector2<f64>], slide: &[Slide]) -> f64 {
+        if self.slots.len() == 1 && !lambda.is_empty() {
+            // a single contact (the common case), without the loops: the same operations
+            return self.single_residual(lambda[0], self.rhs(0), slide[0]);
+        }
         self.natural_map(lambda, slide, |k| self.residual_velocity(k, lambda))
+    }
+
+    /// [`Self::natural_map_residual`] of a single contact whose local right-hand side
+    /// (`b`, or the one its last sweep recorded) is `c`.
+    #[inline(always)]
+    fn single_residual(&self, lambda: Vector2<f64>, c: Vector2<f64>, slide: Slide) -> f64 {
+        let block = self.diagonal_block(0);
+        let slot = &self.slots[0];
+        let (r2, l2) = slot_residual(lambda, c - block.h * lambda, block.rho(), slot, slide);
+        relative_residual(0.0 + r2, 0.0 + l2, 0.0f64.max(slot.s_static))
     }
 
     /// Records slot `k`'s local solve in a Gauss–Seidel sweep: its right-hand side `c_k`
@@ -416,16 +430,7 @@ impl TangentialProblem {
         if m == 1 {
             // a single contact (the common case), without the loops: the same operations
             let [c, _] = self.sweep[0].get();
-            let block = self.diagonal_block(0);
-            let slot = &self.slots[0];
-            let (r2, l2) = slot_residual(
-                lambda[0],
-                c - block.h * lambda[0],
-                block.rho(),
-                slot,
-                slide[0],
-            );
-            return relative_residual(0.0 + r2, 0.0 + l2, 0.0f64.max(slot.s_static));
+            return self.single_residual(lambda[0], c, slide[0]);
         }
         self.natural_map(lambda, slide, |k| {
             let [c, _] = self.sweep[k].get();

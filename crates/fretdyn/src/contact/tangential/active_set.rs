@@ -232,7 +232,7 @@ impl ActiveSet {
     }
 }
 
-/// FNV-1a hash of the statuses and of the slip directions (rounded to 1e-9): a cycle is a
+/// FNV-1a hash of the statuses and of the slip directions (quantised to 1e-9): a cycle is a
 /// state that comes back, not just a stick/slip pattern (a slip that reverses goes
 /// slip → stick → slip with the opposite direction, which is progress). A hash collision could
 /// only make a new state look like a repeated one, which sends the step to the fallback:
@@ -246,9 +246,9 @@ fn pattern(stick: &[bool], direction: &[Vector2<f64>]) -> u64 {
     for (&s, d) in stick.iter().zip(direction) {
         mix(s as u64 + 1);
         if !s {
-            // ties to even: one instruction (`round` is a libm call on x86-64)
-            mix((d.x * 1e9).round_ties_even() as i64 as u64);
-            mix((d.y * 1e9).round_ties_even() as i64 as u64);
+            // truncated, one instruction (rounding is a libm call in baseline x86-64 code)
+            mix((d.x * 1e9) as i64 as u64);
+            mix((d.y * 1e9) as i64 as u64);
         }
     }
     h
