@@ -545,6 +545,12 @@ mod tests {
             let s = free.norm() * (0.05 + 0.9 * uniform());
             let (lam, st) = local_solve(&h, &c, s, s, LocalSolve::Exact);
             assert_eq!(st, Slide::Slip);
+            // on the circle to round-off, though not normalised (|u| = 1 at the root)
+            assert!(
+                (lam.norm() - s).abs() <= 8.0 * f64::EPSILON * s,
+                "|λ| = {} for s = {s}",
+                lam.norm()
+            );
             let size = |t: f64| {
                 (h * s + Matrix2::identity() * t)
                     .lu()
