@@ -262,12 +262,28 @@ pub(crate) fn energy_sums(
 }
 
 /// AVX2 intrinsics (x86-64 only; see the trait's safety note).
+///
+/// `Tag` names a copy of the large kernels (the predictor, the free acceleration, the velocity
+/// update): a step compiled more than once
+/// ([`crate::integrator::simulation::Simulation::step`]) gives each of its versions its own
+/// `Tag`, so that each copy has one caller and is inlined into it (a kernel with two callers
+/// stays a function of its own, and the calls cost the step a few per cent).
 #[cfg(target_arch = "x86_64")]
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Avx2;
+#[derive(Debug)]
+pub(crate) struct Avx2<Tag = ()>(std::marker::PhantomData<Tag>);
 
 #[cfg(target_arch = "x86_64")]
-impl Lanes for Avx2 {
+impl<Tag> Clone for Avx2<Tag> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<Tag> Copy for Avx2<Tag> {}
+
+#[cfg(target_arch = "x86_64")]
+impl<Tag> Lanes for Avx2<Tag> {
     #[inline(always)]
     fn dot(a: &[f64], b: &[f64]) -> f64 {
         // SAFETY: instantiated only when the processor has AVX2 (the trait's note)
@@ -301,7 +317,7 @@ impl Lanes for Avx2 {
     #[inline(always)]
     fn predict(q: &mut [f64], vs: &mut [f64], v: &[f64], a: &[f64], dt: f64, h: f64) {
         // SAFETY: as above
-        unsafe { avx2::predict(q, vs, v, a, dt, h) }
+        unsafe { avx2::predict::<Tag>(q, vs, v, a, dt, h) }
     }
 
     #[inline(always)]
@@ -315,7 +331,7 @@ impl Lanes for Avx2 {
         vs: &[f64],
     ) {
         // SAFETY: as above
-        unsafe { avx2::free_acceleration(out, ai, f, w2, q, c, vs) }
+        unsafe { avx2::free_acceleration::<Tag>(out, ai, f, w2, q, c, vs) }
     }
 
     #[inline(always)]
@@ -330,7 +346,7 @@ impl Lanes for Avx2 {
         f: &[f64],
     ) -> (f64, f64, f64) {
         // SAFETY: as above
-        unsafe { avx2::correct_with_energy(v, vs, a, h, q, w2, c, f) }
+        unsafe { avx2::correct_with_energy::<Tag>(v, vs, a, h, q, w2, c, f) }
     }
 }
 
@@ -601,7 +617,8 @@ mod avx2 {
     /// The processor must have AVX2.
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn predict(
+    #[allow(clippy::extra_unused_type_parameters)] // `Tag`: a copy per caller ([`super::Avx2`])
+    pub(super) unsafe fn predict<Tag>(
         q: &mut [f64],
         vs: &mut [f64],
         v: &[f64],
@@ -661,7 +678,8 @@ mod avx2 {
     #[inline]
     #[target_feature(enable = "avx2")]
     #[allow(clippy::too_many_arguments)]
-    pub(super) unsafe fn free_acceleration(
+    #[allow(clippy::extra_unused_type_parameters)] // `Tag`: a copy per caller ([`super::Avx2`])
+    pub(super) unsafe fn free_acceleration<Tag>(
         out: &mut [f64],
         ai: &[f64],
         f: &[f64],
@@ -716,7 +734,8 @@ mod avx2 {
     #[inline]
     #[target_feature(enable = "avx2")]
     #[allow(clippy::too_many_arguments)]
-    pub(super) unsafe fn correct_with_energy(
+    #[allow(clippy::extra_unused_type_parameters)] // `Tag`: a copy per caller ([`super::Avx2`])
+    pub(super) unsafe fn correct_with_energy<Tag>(
         v: &mut [f64],
         vs: &[f64],
         a: &[f64],
@@ -851,11 +870,11 @@ mod tests {
             let [a, b, c, vs, acc, q, w2, damping, f] =
                 std::array::from_fn(|k| values(n, 10 * n as u64 + k as u64));
             assert_eq!(
-                Avx2::dot(&a, &b).to_bits(),
+                Avx2::<()>::dot(&a, &b).to_bits(),
                 Portable::dot(&a, &b).to_bits(),
                 "{n}"
             );
-            let (x, y) = (Avx2::dot2(&a, &b, &c), Portable::dot2(&a, &b, &c));
+            let (x, y) = (Avx2::<()>::dot2(&a, &b, &c), Portable::dot2(&a, &b, &c));
             assert_eq!(
                 (x.0.to_bits(), x.1.to_bits()),
                 (y.0.to_bits(), y.1.to_bits())
@@ -864,7 +883,7 @@ mod tests {
             for rows in 0..10 {
                 let m = values(rows * n, 7 * n as u64 + rows as u64);
                 let (mut o1, mut o2) = (vec![f64::NAN; rows], vec![f64::NAN; rows]);
-                Avx2::dots(&m, &a, &mut o1);
+                Avx2::<()>::dots(&m, &a, &mut o1);
                 Portable::dots(&m, &a, &mut o2);
                 for r in 0..rows {
                     let single = Portable::dot(&m[r * n..(r + 1) * n], &a);
@@ -874,17 +893,18 @@ mod tests {
             }
             let (mut q1, mut q2, mut s1, mut s2) =
                 (q.clone(), q.clone(), vec![0.0; n], vec![0.0; n]);
-            Avx2::predict(&mut q1, &mut s1, &vs, &acc, 0.37, 0.185);
+            Avx2::<()>::predict(&mut q1, &mut s1, &vs, &acc, 0.37, 0.185);
             Portable::predict(&mut q2, &mut s2, &vs, &acc, 0.37, 0.185);
             let (mut a1, mut a2) = (vec![0.0; n], vec![0.0; n]);
-            Avx2::free_acceleration(&mut a1, &w2, &f, &damping, &q, &b, &c);
+            Avx2::<()>::free_acceleration(&mut a1, &w2, &f, &damping, &q, &b, &c);
             Portable::free_acceleration(&mut a2, &w2, &f, &damping, &q, &b, &c);
             let all = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(all(&q1), all(&q2), "{n}");
             assert_eq!(all(&s1), all(&s2), "{n}");
             assert_eq!(all(&a1), all(&a2), "{n}");
             let (mut v1, mut v2) = (vec![0.0; n], vec![0.0; n]);
-            let e1 = Avx2::correct_with_energy(&mut v1, &vs, &acc, 0.37, &q, &w2, &damping, &f);
+            let e1 =
+                Avx2::<()>::correct_with_energy(&mut v1, &vs, &acc, 0.37, &q, &w2, &damping, &f);
             let e2 = Portable::correct_with_energy(&mut v2, &vs, &acc, 0.37, &q, &w2, &damping, &f);
             let bits = |e: (f64, f64, f64)| (e.0.to_bits(), e.1.to_bits(), e.2.to_bits());
             assert_eq!(bits(e1), bits(e2), "{n}");
@@ -896,13 +916,13 @@ mod tests {
             // slice (the AVX2 tail's stores)
             let (mut y1, mut y2) = (q.clone(), q.clone());
             y1.push(f64::NAN);
-            Avx2::axpy(&mut y1[..n], -0.37, &a);
+            Avx2::<()>::axpy(&mut y1[..n], -0.37, &a);
             Portable::axpy(&mut y2, -0.37, &a);
             let expected: Vec<u64> = (0..n).map(|i| (q[i] + -0.37 * a[i]).to_bits()).collect();
             assert_eq!(all(&y1[..n]), expected, "{n}");
             assert_eq!(all(&y2), expected, "{n}");
             assert!(y1[n].is_nan());
-            Avx2::scale(&mut y1[..n], 1.7, &b);
+            Avx2::<()>::scale(&mut y1[..n], 1.7, &b);
             Portable::scale(&mut y2, 1.7, &b);
             let expected: Vec<u64> = (0..n).map(|i| (1.7 * b[i]).to_bits()).collect();
             assert_eq!(all(&y1[..n]), expected, "{n}");

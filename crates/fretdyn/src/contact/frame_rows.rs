@@ -97,11 +97,19 @@ impl FrameRows {
         &self.rows[a * p..(a + 1) * p]
     }
 
-    /// Signed distance `s` along the declared normal at time `t` for modal displacements `q`.
+    /// Signed distance `s` along the declared normal at time `t` for modal displacements `q`
+    /// (`fixed`: whether the obstacle's `motion` is [fixed](Motion::is_fixed), which the
+    /// caller may know when it is compiled).
     #[inline(always)]
-    pub(crate) fn distance<K: Lanes>(&self, q: &[f64], motion: &Motion, t: f64) -> f64 {
+    pub(crate) fn distance<K: Lanes>(
+        &self,
+        q: &[f64],
+        fixed: bool,
+        motion: &Motion,
+        t: f64,
+    ) -> f64 {
         let s = K::dot(self.row(0), q) + self.offset;
-        if motion.is_fixed() {
+        if fixed {
             s
         } else {
             s - motion.at(t).0.dot(&self.normal)

@@ -1,6 +1,7 @@
 //! Phase 4 of a step — the bookkeeping: energy and powers for the balance, the output
 //! sample, the per-contact values for the statistics, and the results (THEORY §5).
 
+use super::contact_kinds::ContactKinds;
 use super::{ContactState, RunResults, Simulation, Termination};
 use crate::contact::frame_rows::FrameRows;
 use crate::contact::friction::Slide;
@@ -14,7 +15,10 @@ impl Simulation<'_> {
     /// `modal`: the structure's energy, modal damping power and external power
     /// ([`crate::integrator::central_difference::CentralDifference::energy_and_powers`]).
     #[inline(always)]
-    pub(super) fn energy_and_powers(&self, modal: (f64, f64, f64)) -> (f64, [f64; 5]) {
+    pub(super) fn energy_and_powers<O: ContactKinds>(
+        &self,
+        modal: (f64, f64, f64),
+    ) -> (f64, [f64; 5]) {
         let (mut e, modal_damping, mut external) = modal;
         // the external force holds the fluid-elastic one: its power apart
         let fluid = match &self.fluid {
@@ -29,12 +33,12 @@ impl Simulation<'_> {
             let (c, s) = (&self.model.contacts[k], &self.contacts[k]);
             let d = s.frame.penetration;
             e += 0.5 * c.normal.stiffness * d * d;
-            if c.normal.damping > 0.0 {
+            if O::damped(c) {
                 // (R_N − K_N δ) δ̇: zero without damping
                 contact_damping += (s.normal_force - c.normal.stiffness * d) * -s.v_normal;
             }
             tangential -= s.tangential_force.dot(&s.tangential_velocity());
-            if !c.motion.is_fixed() {
+            if !O::is_fixed(c) {
                 // a moving obstacle works on the structure at the rate R·v_obstacle
                 obstacle += s.force().dot(&s.frame.velocity);
             }

@@ -10,8 +10,8 @@
 
 use nalgebra::{Vector2, Vector3};
 
+use super::contact_kinds::ContactKinds;
 use super::{ContactState, Simulation, Tangential, contact_rows, contact_states};
-use crate::contact::Contact;
 use crate::contact::frame_rows::FrameRows;
 use crate::kernels::Lanes;
 use crate::structure::modal::{recombine, recombine_with};
@@ -70,23 +70,23 @@ impl Simulation<'_> {
     /// ([`ContactState::accumulable`]: for an open contact, its penetration squared is at
     /// most a quarter of the bound), checked here where the penetration is at hand.
     #[inline(always)]
-    pub(super) fn detect<K: Lanes>(&mut self, t: f64, predicted: bool) -> bool {
+    pub(super) fn detect<K: Lanes, O: ContactKinds>(&mut self, t: f64, predicted: bool) -> bool {
         let velocity = if predicted {
             &self.cd.qd_star
         } else {
             &self.cd.qd
         };
         let p = self.cd.q.len();
-        let penalty = matches!(self.tangential, Tangential::Penalty { .. });
+        let penalty = O::penalty(matches!(self.tangential, Tangential::Penalty { .. }));
         self.closed.clear();
         let quarter_bound = 0.25 * self.accumulation_bound;
         let mut open_within = true;
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
             state.tangential_force = Vector2::zeros();
             state.held = false;
-            match &self.frame_rows[k] {
+            match O::rows(&self.frame_rows[k]) {
                 Some(rows) => {
-                    state.distance = rows.distance::<K>(&self.cd.q, &c.motion, t);
+                    state.distance = rows.distance::<K>(&self.cd.q, O::is_fixed(c), &c.motion, t);
                     rows.update(state.distance, &mut state.frame);
                 }
                 None => {
@@ -106,12 +106,17 @@ impl Simulation<'_> {
             self.closed.push(k);
             let pt = &self.model.basis.points[c.point];
             // an open contact's velocity is only needed at output samples
-            if !c.motion.is_fixed() {
+            if !O::is_fixed(c) {
                 state.frame.velocity = c.motion.at(t).1;
             }
-            match &self.frame_rows[k] {
+            match O::rows(&self.frame_rows[k]) {
                 Some(frame_rows) => {
-                    state.set_velocity::<K>(Kinematics::Rows(frame_rows), c, velocity, penalty);
+                    state.set_velocity::<K>(
+                        Kinematics::Rows(frame_rows),
+                        O::damped(c),
+                        velocity,
+                        penalty,
+                    );
                 }
                 None => {
                     let rows = if c.at_surface() {
@@ -121,7 +126,12 @@ impl Simulation<'_> {
                     } else {
                         &pt.rows[..]
                     };
-                    state.set_velocity::<K>(Kinematics::Point(rows), c, velocity, penalty);
+                    state.set_velocity::<K>(
+                        Kinematics::Point(rows),
+                        O::damped(c),
+                        velocity,
+                        penalty,
+                    );
                 }
             }
             state.normal_force = c.normal.force(state.frame.penetration, -state.v_normal);
@@ -142,28 +152,30 @@ impl Simulation<'_> {
     /// which also becomes the frame's velocity for the obstacle's power. (The tangential part
     /// of a contact [held](ContactState::held) in stick is read as exactly 0, THEORY §5.)
     #[inline(always)]
-    pub(super) fn full_step_velocities<K: Lanes>(&mut self, all: bool) {
+    pub(super) fn full_step_velocities<K: Lanes, O: ContactKinds>(&mut self, all: bool) {
         if all {
             for k in 0..self.contacts.len() {
-                self.full_step_velocity::<K>(k);
+                self.full_step_velocity::<K, O>(k);
             }
         } else {
             for i in 0..self.closed.len() {
-                self.full_step_velocity::<K>(self.closed[i]);
+                self.full_step_velocity::<K, O>(self.closed[i]);
             }
         }
     }
 
     /// [`Self::full_step_velocities`] of contact `k`.
     #[inline(always)]
-    fn full_step_velocity<K: Lanes>(&mut self, k: usize) {
+    fn full_step_velocity<K: Lanes, O: ContactKinds>(&mut self, k: usize) {
         let p = self.cd.q.len();
         let (c, state) = (&self.model.contacts[k], &mut self.contacts[k]);
-        if !c.motion.is_fixed() {
+        if !O::is_fixed(c) {
             state.frame.velocity = moving_full_step(&c.motion, self.step, self.settings.dt);
         }
-        match &self.frame_rows[k] {
-            Some(rows) => state.set_velocity::<K>(Kinematics::Rows(rows), c, &self.cd.qd, true),
+        match O::rows(&self.frame_rows[k]) {
+            Some(rows) => {
+                state.set_velocity::<K>(Kinematics::Rows(rows), O::damped(c), &self.cd.qd, true)
+            }
             None => {
                 let pt = &self.model.basis.points[c.point];
                 if c.at_surface() && !state.closed {
@@ -171,7 +183,7 @@ impl Simulation<'_> {
                     c.surface_rows(pt, &state.frame.normal, out);
                 }
                 let rows = contact_rows(self.model, &self.surface_rows, k);
-                state.set_velocity::<K>(Kinematics::Point(rows), c, &self.cd.qd, true);
+                state.set_velocity::<K>(Kinematics::Point(rows), O::damped(c), &self.cd.qd, true);
             }
         }
     }
@@ -188,18 +200,17 @@ pub(super) enum Kinematics<'a> {
 impl ContactState {
     /// Sets the velocity relative to the obstacle, in the frame, for modal velocities `qd`
     /// (the frame's velocity is the obstacle's). The normal component is formed only when
-    /// the normal law has damping, the only use of it (`R_N = K_N δ + C_N δ̇`, THEORY §3); it
-    /// is 0 otherwise. The tangential one only when `tangential` (the predicted tangential
+    /// the normal law has damping (`damped`), the only use of it (`R_N = K_N δ + C_N δ̇`,
+    /// THEORY §3); it is 0 otherwise. The tangential one only when `tangential` (the predicted tangential
     /// velocity serves the penalty law only: the Lagrange methods form `L q̇*` themselves).
     #[inline(always)]
     pub(super) fn set_velocity<K: Lanes>(
         &mut self,
         kinematics: Kinematics,
-        c: &Contact,
+        damped: bool,
         qd: &[f64],
         tangential: bool,
     ) {
-        let damped = c.normal.damping > 0.0;
         match kinematics {
             Kinematics::Rows(rows) => {
                 if tangential {

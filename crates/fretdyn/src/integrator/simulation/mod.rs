@@ -14,6 +14,7 @@
 //! [`RunResults`], [`Termination`], [`Snapshot`]).
 
 mod bookkeeping;
+mod contact_kinds;
 mod detection;
 mod normal;
 mod run;
@@ -24,6 +25,7 @@ pub use run::{Divergence, Progress, RunResults, Termination, run, simulate};
 pub use settings::RunSettings;
 
 use bookkeeping::{contact_step, step_values};
+use contact_kinds::{AnyContacts, CommonContacts, ContactKinds};
 use settings::round_down;
 use tangential::{LagrangeSolver, Tangential};
 
@@ -216,6 +218,8 @@ pub struct Simulation<'m> {
     accumulation_bound: f64,
     /// Run the steps as code compiled for AVX2 and FMA ([`Self::step`]).
     wide: bool,
+    /// Run the contact phases compiled for the common case ([`contact_kinds`]).
+    common_contacts: bool,
     /// Where the friction work is done, when tracked ([`Self::track_wear`]).
     wear_map: Option<WearMap>,
 }
@@ -555,6 +559,8 @@ impl<'m> Simulation<'m> {
                 }
             }
         }
+        let common_contacts =
+            contact_kinds::is_common(&model.contacts, &frame_rows, &settings.method);
         Ok(Self {
             model,
             settings,
@@ -590,6 +596,7 @@ impl<'m> Simulation<'m> {
             next_sample: settings.output_every,
             accumulation_bound: Self::accumulation_bound(settings),
             wide: wide_vectors(),
+            common_contacts,
         })
     }
 
@@ -597,14 +604,14 @@ impl<'m> Simulation<'m> {
     fn start(&mut self) {
         self.external_force::<Portable>(0.0);
         self.fluid_elastic_force::<Portable>(0, false);
-        let _ = self.detect::<Portable>(0.0, false);
-        self.contact_forces::<Portable>();
+        let _ = self.detect::<Portable, AnyContacts>(0.0, false);
+        self.contact_forces::<Portable, AnyContacts>();
         self.cd.start(normal::modal_force(
             &self.closed,
             &self.external,
             &self.force,
         ));
-        self.full_step_velocities::<Portable>(true);
+        self.full_step_velocities::<Portable, AnyContacts>(true);
         for c in &mut self.contacts {
             // the velocities were the initial (full-step) ones already
             if c.closed && c.tangential_force == Vector2::zeros() {
@@ -615,7 +622,8 @@ impl<'m> Simulation<'m> {
                 };
             }
         }
-        let (e, powers) = self.energy_and_powers(self.cd.energy_and_powers(&self.external));
+        let (e, powers) =
+            self.energy_and_powers::<AnyContacts>(self.cd.energy_and_powers(&self.external));
         self.energy = EnergyBalance::start(e, powers);
         self.statistics.start(
             self.contacts
@@ -640,14 +648,29 @@ impl<'m> Simulation<'m> {
     /// On a processor with AVX2 and FMA (x86-64, detected at run time) the step runs as code
     /// compiled for them: the same operations in the same order on wider vectors, so the
     /// results are bit for bit those of the portable code ([`Self::use_portable_kernels`]).
+    ///
+    /// In the common case (every obstacle a fixed plane or fixed bars, an undamped normal law,
+    /// friction by Lagrange multipliers) the phases that visit the contacts run as the same
+    /// code compiled for that case only ([`contact_kinds`], [`Self::runs_common_step`]): the
+    /// same results bit for bit ([`Self::use_general_step`]).
     pub fn step(&mut self) -> std::result::Result<(), Divergence> {
         #[cfg(target_arch = "x86_64")]
         if self.wide {
             // SAFETY: `wide` is set only when the processor has AVX2 and FMA (checked at run
             // time in `allocate`).
-            return unsafe { self.step_avx2() };
+            return unsafe {
+                if self.common_contacts {
+                    self.step_avx2::<CommonContacts>()
+                } else {
+                    self.step_avx2::<AnyContacts>()
+                }
+            };
         }
-        self.step_with::<Portable>()
+        if self.common_contacts {
+            self.step_with::<Portable, CommonContacts>()
+        } else {
+            self.step_with::<Portable, AnyContacts>()
+        }
     }
 
     /// Runs the steps with the portable (SSE2 on x86-64) code even when the processor has
@@ -656,21 +679,35 @@ impl<'m> Simulation<'m> {
         self.wide = false;
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn step_avx2(&mut self) -> std::result::Result<(), Divergence> {
-        self.step_with::<crate::kernels::Avx2>()
+    /// Runs the steps with the code compiled for any contact even when the case is the
+    /// common one ([`contact_kinds`]): for comparisons and tests.
+    pub fn use_general_step(&mut self) {
+        self.common_contacts = false;
     }
 
-    /// The step with the reduction kernels `K` ([`crate::kernels`]).
+    /// Whether the steps run the code compiled for the common case: every obstacle a fixed
+    /// plane or fixed bars, an undamped normal law, friction by Lagrange multipliers (the same
+    /// results as the general code, bit for bit, faster).
+    pub fn runs_common_step(&self) -> bool {
+        self.common_contacts
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn step_avx2<O: ContactKinds>(&mut self) -> std::result::Result<(), Divergence> {
+        // each version of the step its own copy of the kernels, inlined
+        self.step_with::<crate::kernels::Avx2<O>, O>()
+    }
+
+    /// The step with the reduction kernels `K` ([`crate::kernels`]), for the contacts `O`.
     #[inline(always)]
-    fn step_with<K: Lanes>(&mut self) -> std::result::Result<(), Divergence> {
-        self.try_step::<K>().inspect_err(|_| self.step -= 1)
+    fn step_with<K: Lanes, O: ContactKinds>(&mut self) -> std::result::Result<(), Divergence> {
+        self.try_step::<K, O>().inspect_err(|_| self.step -= 1)
     }
 
     /// The step; on `Err`, nothing of it was accumulated or sampled.
     #[inline(always)]
-    fn try_step<K: Lanes>(&mut self) -> std::result::Result<(), Divergence> {
+    fn try_step<K: Lanes, O: ContactKinds>(&mut self) -> std::result::Result<(), Divergence> {
         self.step += 1;
         let t = self.step as f64 * self.settings.dt;
         self.cd.predict_with::<K>();
@@ -678,8 +715,8 @@ impl<'m> Simulation<'m> {
         if self.fluid.is_some() {
             self.fluid_elastic_force::<K>(self.step, true);
         }
-        let open_within = self.detect::<K>(t, true);
-        self.contact_forces::<K>();
+        let open_within = self.detect::<K, O>(t, true);
+        self.contact_forces::<K, O>();
         self.cd.free_acceleration_with::<K>(normal::modal_force(
             &self.closed,
             &self.external,
@@ -687,7 +724,7 @@ impl<'m> Simulation<'m> {
         ));
         self.lagrange::<K>();
         let modal = self.cd.correct_with::<K>(&self.external);
-        self.full_step_velocities::<K>(false);
+        self.full_step_velocities::<K, O>(false);
 
         let dt = self.settings.dt;
         let bound = self.accumulation_bound;
@@ -703,14 +740,14 @@ impl<'m> Simulation<'m> {
             let first = self.contacts.iter().position(|c| !c.accumulable(bound));
             return Err(diverged(first));
         }
-        let (e, powers) = self.energy_and_powers(modal);
+        let (e, powers) = self.energy_and_powers::<O>(modal);
         let magnitude = e.abs() + powers.iter().map(|p| p.abs()).sum::<f64>();
         if magnitude > bound || magnitude.is_nan() {
             return Err(diverged(None));
         }
         let sample = self.step == self.next_sample;
         if sample {
-            self.full_step_velocities::<K>(true);
+            self.full_step_velocities::<K, O>(true);
             if let Some(k) = self.sample() {
                 self.recorder.discard_last();
                 return Err(diverged(Some(k)));
@@ -723,7 +760,7 @@ impl<'m> Simulation<'m> {
             .iter()
             .zip(&model.contacts)
             .zip(&self.frame_rows)
-            .map(|((s, c), rows)| contact_step(s, c, rows.as_ref(), t));
+            .map(|((s, c), rows)| contact_step(s, c, O::rows(rows), t));
         self.statistics
             .step(&self.settings.statistics, t, dt, values);
         if let Some(map) = &mut self.wear_map {

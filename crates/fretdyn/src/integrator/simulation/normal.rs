@@ -1,6 +1,7 @@
 //! Phase 2 of a step — the modal force: external force plus the contact forces of the closed
 //! contacts, with the penalty tangential law (THEORY §2 step 4, §4.1).
 
+use super::contact_kinds::ContactKinds;
 use super::{Simulation, Tangential, contact_rows, contact_states};
 use crate::kernels::Lanes;
 use crate::structure::modal::project_add;
@@ -9,8 +10,10 @@ impl Simulation<'_> {
     /// Step 4 (and the penalty tangential forces): modal force `f = f_ext + Σ Φ_cᵀ R_c`,
     /// formed only when a contact is closed ([`modal_force`] is `f_ext` otherwise).
     #[inline(always)]
-    pub(super) fn contact_forces<K: Lanes>(&mut self) {
-        if let Tangential::Penalty { settings, contacts } = &mut self.tangential {
+    pub(super) fn contact_forces<K: Lanes, O: ContactKinds>(&mut self) {
+        if let (true, Tangential::Penalty { settings, contacts }) =
+            (O::penalty(true), &mut self.tangential)
+        {
             for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
                 if state.closed {
                     let vt = state.tangential_velocity();
@@ -34,7 +37,7 @@ impl Simulation<'_> {
         self.force.copy_from_slice(&self.external);
         for &k in &self.closed {
             let state = &self.contacts[k];
-            match &self.frame_rows[k] {
+            match O::rows(&self.frame_rows[k]) {
                 Some(rows) => rows.project_add::<K>(
                     &state.frame.normal,
                     state.normal_force,
