@@ -970,7 +970,9 @@ pub fn statistics_run(
     let total = settings.steps;
     let mut termination = Termination::Completed;
     while sim.steps_done() < total {
-        if let Err(d) = sim.step() {
+        // to the next multiple of 1024 steps, where the finished impacts and blocks are let go
+        let n = sim.steps_done();
+        if let Err(d) = sim.steps((total - n).min(1024 - n % 1024)) {
             termination = d.into_termination(model);
             break;
         }

@@ -304,7 +304,14 @@ fn drive(
     let mut termination = Termination::Completed;
     let model = files.model_contacts.clone();
     while sim.steps_done() < total && sim.target_met().is_none() {
-        if let Err(d) = sim.step() {
+        // to the next multiple of 1024 steps or of the checkpoints' steps, where the loop
+        // below looks at the clock and the observer
+        let n = sim.steps_done();
+        let mut chunk = (total - n).min(1024 - n % 1024);
+        if let Some(every) = stream.checkpoint_every_steps.filter(|&e| e > 0) {
+            chunk = chunk.min(every - n % every);
+        }
+        if let Err(d) = sim.steps(chunk) {
             termination = Termination::Diverged {
                 step: d.step,
                 time: d.time,

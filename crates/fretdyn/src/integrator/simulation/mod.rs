@@ -654,22 +654,31 @@ impl<'m> Simulation<'m> {
     /// code compiled for that case only ([`contact_kinds`], [`Self::runs_common_step`]): the
     /// same results bit for bit ([`Self::use_general_step`]).
     pub fn step(&mut self) -> std::result::Result<(), Divergence> {
+        self.steps(1).map(|_| ())
+    }
+
+    /// Up to `n` steps ([`Self::step`]): fewer when the recorder is full after a step (to be
+    /// drained, [`Recorder::is_full`]) or when the statistics meet their target in one of
+    /// them ([`Self::target_met`]: the run stops there). Returns the steps done; on a
+    /// divergence, the steps before it are kept. The same results as `n` calls of
+    /// [`Self::step`], for less work per step (the code is chosen once).
+    pub fn steps(&mut self, n: u64) -> std::result::Result<u64, Divergence> {
         #[cfg(target_arch = "x86_64")]
         if self.wide {
             // SAFETY: `wide` is set only when the processor has AVX2 and FMA (checked at run
             // time in `allocate`).
             return unsafe {
                 if self.common_contacts {
-                    self.step_avx2::<CommonContacts>()
+                    self.steps_avx2::<CommonContacts>(n)
                 } else {
-                    self.step_avx2::<AnyContacts>()
+                    self.steps_avx2::<AnyContacts>(n)
                 }
             };
         }
         if self.common_contacts {
-            self.step_with::<Portable, CommonContacts>()
+            self.steps_with::<Portable, CommonContacts>(n)
         } else {
-            self.step_with::<Portable, AnyContacts>()
+            self.steps_with::<Portable, AnyContacts>(n)
         }
     }
 
@@ -694,15 +703,29 @@ impl<'m> Simulation<'m> {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn step_avx2<O: ContactKinds>(&mut self) -> std::result::Result<(), Divergence> {
+    unsafe fn steps_avx2<O: ContactKinds>(
+        &mut self,
+        n: u64,
+    ) -> std::result::Result<u64, Divergence> {
         // each version of the step its own copy of the kernels, inlined
-        self.step_with::<crate::kernels::Avx2<O>, O>()
+        self.steps_with::<crate::kernels::Avx2<O>, O>(n)
     }
 
-    /// The step with the reduction kernels `K` ([`crate::kernels`]), for the contacts `O`.
+    /// [`Self::steps`] with the reduction kernels `K` ([`crate::kernels`]), for the contacts
+    /// `O`.
     #[inline(always)]
-    fn step_with<K: Lanes, O: ContactKinds>(&mut self) -> std::result::Result<(), Divergence> {
-        self.try_step::<K, O>().inspect_err(|_| self.step -= 1)
+    fn steps_with<K: Lanes, O: ContactKinds>(
+        &mut self,
+        n: u64,
+    ) -> std::result::Result<u64, Divergence> {
+        let until_target = self.statistics.target_met().is_none();
+        for done in 1..=n {
+            self.try_step::<K, O>().inspect_err(|_| self.step -= 1)?;
+            if self.recorder.is_full() || (until_target && self.statistics.target_met().is_some()) {
+                return Ok(done);
+            }
+        }
+        Ok(n)
     }
 
     /// The step; on `Err`, nothing of it was accumulated or sampled.

@@ -105,7 +105,9 @@ pub fn run(
     let total = settings.steps;
     let mut termination = Termination::Completed;
     while sim.steps_done() < total && sim.target_met().is_none() {
-        if let Err(d) = sim.step() {
+        // to the next multiple of 1024 steps, where the observer is called
+        let n = sim.steps_done();
+        if let Err(d) = sim.steps((total - n).min(1024 - n % 1024)) {
             termination = d.into_termination(model);
             break;
         }
