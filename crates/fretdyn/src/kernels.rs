@@ -265,7 +265,7 @@ pub(crate) fn energy_sums(
 ///
 /// `Tag` names a copy of the large kernels (the predictor, the free acceleration, the velocity
 /// update): a step compiled more than once
-/// ([`crate::integrator::simulation::Simulation::step`]) gives each of its versions its own
+/// ([`crate::integrator::simulation::Simulation::steps`]) gives each of its versions its own
 /// `Tag`, so that each copy has one caller and is inlined into it (a kernel with two callers
 /// stays a function of its own, and the calls cost the step a few per cent).
 #[cfg(target_arch = "x86_64")]

@@ -8,9 +8,9 @@
 //! for the common case ([`CommonContacts`]), in which the paths of the others (a hole's 3-D
 //! point, surface rows, a moving obstacle's velocities, the normal damping, the penalty
 //! tangential law) are not compiled and the tests that choose them are constants.
-//! [`Simulation::step`](super::Simulation::step) runs the second when every contact and the
+//! [`Simulation::steps`](super::Simulation::steps) runs the second when every contact and the
 //! method qualify ([`is_common`]). Both run the same floating-point operations in the same
-//! order: their results are the same bit for bit (tested: `common_contacts_step_is_the_general_one`).
+//! order: their results are the same bit for bit (`tests/common_contacts.rs`).
 
 use crate::contact::Contact;
 use crate::contact::frame_rows::FrameRows;
@@ -29,9 +29,9 @@ pub(super) trait ContactKinds {
         if Self::COMMON {
             debug_assert!(rows.is_some());
             // SAFETY: the step runs under `CommonContacts` only when every contact has frame
-            // rows (`Simulation::try_step` dispatches on `common_contacts`, set from
-            // [`is_common`] when the simulation is allocated), and a simulation's frame rows
-            // never change. The trait is private to the step's module, whose phases are
+            // rows (`Simulation::steps` dispatches on `common_contacts`, set from [`is_common`]
+            // when the simulation is allocated, in its only constructor), and a simulation's
+            // frame rows never change. The trait is private to the step's module, whose phases are
             // called from that dispatch only (its start runs under `AnyContacts`).
             Some(unsafe { rows.as_ref().unwrap_unchecked() })
         } else {

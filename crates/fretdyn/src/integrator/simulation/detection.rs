@@ -201,8 +201,9 @@ impl ContactState {
     /// Sets the velocity relative to the obstacle, in the frame, for modal velocities `qd`
     /// (the frame's velocity is the obstacle's). The normal component is formed only when
     /// the normal law has damping (`damped`), the only use of it (`R_N = K_N δ + C_N δ̇`,
-    /// THEORY §3); it is 0 otherwise. The tangential one only when `tangential` (the predicted tangential
-    /// velocity serves the penalty law only: the Lagrange methods form `L q̇*` themselves).
+    /// THEORY §3); it is 0 otherwise. The tangential one only when `tangential` (the
+    /// predicted tangential velocity serves the penalty law only: the Lagrange methods form
+    /// `L q̇*` themselves).
     #[inline(always)]
     pub(super) fn set_velocity<K: Lanes>(
         &mut self,
