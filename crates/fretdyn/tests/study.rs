@@ -142,3 +142,23 @@ fn study_errors_name_the_field() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Every study shipped in `examples/` builds and checks every run's case as `fretdyn sweep`
+/// would before it runs anything (a base case edited later can leave a study invalid:
+/// `study_seeds.toml` shortened the run below the base case's statistics blocks).
+#[test]
+fn every_example_study_checks() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let mut studies = 0;
+    for entry in std::fs::read_dir(&dir).expect("examples folder") {
+        let path = entry.expect("an entry").path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if !(name.starts_with("study_") && name.ends_with(".toml")) {
+            continue;
+        }
+        let study = Study::from_file(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        study.check(1).unwrap_or_else(|e| panic!("{name}: {e}"));
+        studies += 1;
+    }
+    assert!(studies >= 5, "the examples' studies: {studies}");
+}
