@@ -283,13 +283,15 @@ fn disk_boundary_solve(
         // φ = 1/|u| − 1, φ' = Σ u_k²/(s h_k + t) / |u|³, so the Newton step φ/φ' is
         // |u|²(1 − |u|) / Σ u_k²/(s h_k + t). With e_k = s h_k + t, D = e₀e₁,
         // N = c₀²e₁² + c₁²e₀² = D²|u|² and M = c₀²e₁³ + c₁²e₀³, it is N (D − √N) / M:
-        // one square root and one division on the dependent chain (the form with u needs
-        // three divisions).
+        // one square root and one division (the form with u needs three), side by side on
+        // the dependent chain — 1/M is formed while √N is (one rounding more than N (D − √N)
+        // / M, and 3–5 % of the exact methods' step time less).
         let (e0, e1) = (hs[0] + t, hs[1] + t);
         let (w0, w1) = (c2[0] * e1, c2[1] * e0);
         let n = w0 * e1 + w1 * e0;
         let m = w0 * e1 * e1 + w1 * e0 * e0;
-        let mut step = n * (e0 * e1 - n.sqrt()) / m;
+        let inverse_m = 1.0 / m;
+        let mut step = n * (e0 * e1 - n.sqrt()) * inverse_m;
         if !step.is_finite() {
             // overflow of the products, or a pole (e_k = 0 where c_k = 0): the form with u
             step = newton_step_direct(&cp, &hs, t);
