@@ -401,6 +401,15 @@ impl TangentialProblem {
         relative_residual(0.0 + r2, 0.0 + l2, 0.0f64.max(slot.s_static))
     }
 
+    /// [`Self::natural_map_residual_after_sweep`] of a single closed contact whose sweep
+    /// found `lambda` with status `slide`: the same operations, inlined into the caller (the
+    /// common case of a rattling structure, at every step with a closed contact).
+    #[inline(always)]
+    pub fn single_residual_after_sweep(&self, lambda: Vector2<f64>, slide: Slide) -> f64 {
+        let [c, _] = self.sweep[0].get();
+        self.single_residual(lambda, c, slide)
+    }
+
     /// Records slot `k`'s local solve in a Gauss–Seidel sweep: its right-hand side `c_k`
     /// (the other contacts' λ as they were then) and the change of its `λ_k`.
     #[inline]

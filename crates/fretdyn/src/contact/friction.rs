@@ -224,6 +224,7 @@ pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
 /// `c` lies along the stiff eigenvector of an `H` anisotropic by 10³, a tube sliding round a
 /// hole) costs Newton one step down (an earlier version projected radially when the start
 /// was not below the root, off by up to 1e-4 in direction).
+#[inline(always)]
 fn disk_boundary_solve(
     block: &DiagonalBlock,
     c: &Vector2<f64>,
@@ -270,7 +271,9 @@ fn disk_boundary_solve(
             let inverse_norm = norm * inverse_n2;
             expansion += inverse_norm * (1.5 * mu2 - 2.0 * inverse_norm * mu2 * (w1 - w0) * delta);
         }
-        let t = lower.max(norm - hs[0].max(hs[1])).max(0.0).max(expansion);
+        // the bound that does not need the expansion first, off its dependency chain
+        let floor = lower.max(norm - hs[0].max(hs[1])).max(0.0);
+        let t = floor.max(expansion);
         if t <= lower {
             // on the pole of a singular H: start just above it
             lower + f64::EPSILON * (norm + hs[0].abs().max(hs[1].abs()))

@@ -129,23 +129,12 @@ impl ActiveSet {
             let mut status_changed = false;
             let mut direction_changed = false;
             for (k, slot) in problem.slots().iter().enumerate() {
-                // contact k's exact local problem, the others frozen
-                let local = |lambda: &[Vector2<f64>]| {
-                    local_solve_block(
-                        problem.diagonal_block(k),
-                        &problem.local_rhs(k, lambda),
-                        slot.s_static,
-                        slot.s_dynamic,
-                        LocalSolve::Exact,
-                        problem.newton_start(k),
-                    )
-                };
                 if self.stick[k] {
                     // |λ_k| > s_static (1 + 1e-12), compared squared
                     let bound = slot.s_static * (1.0 + 1e-12);
                     if lambda[k].norm_squared() > bound * bound {
                         self.stick[k] = false;
-                        let (local, _) = local(lambda);
+                        let (local, _) = local_exact(problem, k, lambda);
                         let n = local.norm();
                         self.direction[k] = if n > 0.0 {
                             local / n
@@ -155,7 +144,7 @@ impl ActiveSet {
                         status_changed = true;
                     }
                 } else {
-                    let (local, local_slide) = local(lambda);
+                    let (local, local_slide) = local_exact(problem, k, lambda);
                     if local_slide == Slide::Stick {
                         self.stick[k] = true;
                         status_changed = true;
@@ -230,6 +219,25 @@ impl ActiveSet {
         }
         outcome
     }
+}
+
+/// Contact `k`'s exact local problem, the others frozen at `lambda` (THEORY §4.4); in line
+/// (it runs for every contact at every status iteration).
+#[inline(always)]
+fn local_exact(
+    problem: &TangentialProblem,
+    k: usize,
+    lambda: &[Vector2<f64>],
+) -> (Vector2<f64>, Slide) {
+    let slot = &problem.slots()[k];
+    local_solve_block(
+        problem.diagonal_block(k),
+        &problem.local_rhs(k, lambda),
+        slot.s_static,
+        slot.s_dynamic,
+        LocalSolve::Exact,
+        problem.newton_start(k),
+    )
 }
 
 /// FNV-1a hash of the statuses and of the slip directions (quantised to 1e-9): a cycle is a

@@ -26,6 +26,10 @@ pub struct Sweeps {
 }
 
 /// Solves the tangential problem from the λ given (warm start) and writes the statuses.
+///
+/// A single closed contact, the common case of a rattling structure, is solved in line
+/// ([`solve_single_radial`], [`solve_single_exact`]); several by [`solve_by_sweeps`].
+#[inline]
 pub fn solve(
     settings: &GaussSeidelSettings,
     problem: &TangentialProblem,
@@ -43,6 +47,18 @@ pub fn solve(
             return sweeps;
         }
     }
+    solve_by_sweeps(settings, problem, lambda, slide)
+}
+
+/// The sweeps of [`solve`] (module documentation).
+#[inline(never)]
+fn solve_by_sweeps(
+    settings: &GaussSeidelSettings,
+    problem: &TangentialProblem,
+    lambda: &mut [Vector2<f64>],
+    slide: &mut [Slide],
+) -> Sweeps {
+    let m = problem.len();
     let mut residual = None;
     for sweep in 1..=settings.max_sweeps {
         let mut diff2 = 0.0;
@@ -124,7 +140,7 @@ fn solve_single_radial(
     Some(Sweeps {
         count,
         converged: true,
-        residual: Some(problem.natural_map_residual_after_sweep(&lambda[..1], &slide[..1])),
+        residual: Some(problem.single_residual_after_sweep(new, st)),
     })
 }
 
@@ -135,7 +151,7 @@ fn solve_single_radial(
 /// of 1e-14 or more. It is counted, not recomputed (THEORY §4.4). `None` (λ and statuses as
 /// given) when the tolerance is below that, the first sweep's λ is not finite or misses the
 /// residual tolerance: [`solve`] then runs its loop.
-#[inline(never)]
+#[inline]
 fn solve_single_exact(
     settings: &GaussSeidelSettings,
     problem: &TangentialProblem,
@@ -146,7 +162,7 @@ fn solve_single_exact(
         return None;
     }
     let (new, st, count) = single_sweep(settings, problem, lambda[0], LocalSolve::Exact)?;
-    let residual = problem.natural_map_residual_after_sweep(&[new], &[st]);
+    let residual = problem.single_residual_after_sweep(new, st);
     if !(residual <= settings.residual_tolerance) {
         return None;
     }
