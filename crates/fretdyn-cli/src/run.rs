@@ -200,7 +200,8 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
     };
     let needed = series_bytes(case);
     let size = fretdyn::results::recorder::human_bytes;
-    if needed > free {
+    let verdict = disk_verdict(needed, needed, free);
+    if verdict == DiskVerdict::SeriesShort {
         let raise = needed.div_ceil(free.max(1) / 2 + 1).max(2);
         return Err(Failure::input(format!(
             "{}: the run would write {} of time histories in {}, where {} is free: keep fewer samples (multiply output.every by {raise} or more), free some space, or give another output folder (-o DIR)",
@@ -210,7 +211,7 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
             size(free)
         )));
     }
-    if needed.saturating_mul(3) > free {
+    if verdict == DiskVerdict::PackingShort {
         errln!(
             "warning: {}: the run will write {} of time histories in {}, where {} is free, and packing them into results.npz and results.nc at the end needs twice as much again: free some space before the end (a run stopped by a full disk continues with fretdyn run --resume {})",
             path.display(),
@@ -221,6 +222,76 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
         );
     }
     Ok(())
+}
+
+/// [`check_disk`] for a resumed run (a run stopped by a full disk is the usual one): refuses
+/// it when the time histories still to write do not fit (those already in `series/` stay), and
+/// warns, while some are still to write, when packing them at the end will not.
+fn check_disk_to_resume(case: &Case, dir: &Path) -> Result<(), Failure> {
+    let Some(free) = free_space(dir) else {
+        return Ok(());
+    };
+    let total = series_bytes(case);
+    let written = folder_bytes(&dir.join(fretdyn::results::stream::SERIES_DIR));
+    let remaining = total.saturating_sub(written);
+    let size = fretdyn::results::recorder::human_bytes;
+    match disk_verdict(remaining, total, free) {
+        // every time history written: the packing starts at once, and says itself what
+        // stopped it
+        DiskVerdict::Fits => Ok(()),
+        DiskVerdict::PackingShort if remaining == 0 => Ok(()),
+        DiskVerdict::PackingShort => {
+            errln!(
+                "warning: {}: the run will write {} more of time histories, where {} is free, and packing them into results.npz and results.nc at the end needs {} again: free some space before the end",
+                dir.display(),
+                size(remaining),
+                size(free),
+                size(total.saturating_mul(2))
+            );
+            Ok(())
+        }
+        DiskVerdict::SeriesShort => Err(Failure::input(format!(
+            "{}: the run still has {} of time histories to write, where {} is free: free some space, then resume again (fretdyn run --resume {})",
+            dir.display(),
+            size(remaining),
+            size(free),
+            dir.display()
+        ))),
+    }
+}
+
+/// What a disk with `free` bytes allows a run that has `remaining` bytes of time histories
+/// still to write, `total` in all (packed twice at the end: `results.npz`, `results.nc`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum DiskVerdict {
+    Fits,
+    /// The time histories fit, their packing at the end does not.
+    PackingShort,
+    /// The time histories do not fit.
+    SeriesShort,
+}
+
+fn disk_verdict(remaining: u64, total: u64, free: u64) -> DiskVerdict {
+    if remaining > free {
+        DiskVerdict::SeriesShort
+    } else if remaining.saturating_add(total.saturating_mul(2)) > free {
+        DiskVerdict::PackingShort
+    } else {
+        DiskVerdict::Fits
+    }
+}
+
+/// Bytes of the files directly in `dir` (0 when it cannot be read).
+fn folder_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok()?.metadata().ok())
+                .filter(|m| m.is_file())
+                .map(|m| m.len())
+                .sum()
+        })
+        .unwrap_or(0)
 }
 
 /// Hash of the case file's text (a resumed run must use the case it started with), and the
@@ -264,6 +335,7 @@ fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
             dir.display()
         )));
     }
+    check_disk_to_resume(&case, dir)?;
     run_and_write(
         &case,
         &path.display().to_string(),
@@ -640,4 +712,43 @@ fn demo(options: &Options) -> Result<(), Failure> {
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The time histories need `remaining` bytes, their packing twice the run's total: a
+    /// resumed run (some already written) asks less than a fresh one of the same case.
+    #[test]
+    fn the_disk_verdict_counts_what_is_left_and_the_packing() {
+        let total = 1000;
+        // fresh run: the series and two packed copies
+        assert_eq!(disk_verdict(total, total, 3000), DiskVerdict::Fits);
+        assert_eq!(disk_verdict(total, total, 2999), DiskVerdict::PackingShort);
+        assert_eq!(disk_verdict(total, total, 1000), DiskVerdict::PackingShort);
+        assert_eq!(disk_verdict(total, total, 999), DiskVerdict::SeriesShort);
+        // resumed with 600 bytes written: 400 left
+        assert_eq!(disk_verdict(400, total, 2400), DiskVerdict::Fits);
+        assert_eq!(disk_verdict(400, total, 2399), DiskVerdict::PackingShort);
+        assert_eq!(disk_verdict(400, total, 399), DiskVerdict::SeriesShort);
+        // nothing left: only the packing
+        assert_eq!(disk_verdict(0, total, 2000), DiskVerdict::Fits);
+        assert_eq!(
+            disk_verdict(u64::MAX, u64::MAX, u64::MAX - 1),
+            DiskVerdict::SeriesShort
+        );
+    }
+
+    #[test]
+    fn folder_bytes_sums_the_files_of_a_folder() {
+        let dir = std::env::temp_dir().join(format!("fretdyn_folder_bytes_{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        std::fs::write(dir.join("a.npy"), [0u8; 100]).unwrap();
+        std::fs::write(dir.join("b.npy"), [0u8; 28]).unwrap();
+        std::fs::write(dir.join("sub").join("c"), [0u8; 7]).unwrap();
+        assert_eq!(folder_bytes(&dir), 128);
+        assert_eq!(folder_bytes(&dir.join("missing")), 0);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
