@@ -130,7 +130,7 @@ pub fn local_solve(
 /// exact slip solution's Newton start: the root of the contact's last exact slip solve of
 /// this step (NaN: none), where the next one starts — the sweeps and the status iterations
 /// of a step solve the same contact with nearly the same right-hand side.
-#[inline]
+#[inline(always)]
 pub fn local_solve_block(
     block: &DiagonalBlock,
     c: &Vector2<f64>,

@@ -29,7 +29,7 @@ pub struct Sweeps {
 ///
 /// A single closed contact, the common case of a rattling structure, is solved in line
 /// ([`solve_single_radial`], [`solve_single_exact`]); several by [`solve_by_sweeps`].
-#[inline]
+#[inline(always)]
 pub fn solve(
     settings: &GaussSeidelSettings,
     problem: &TangentialProblem,
