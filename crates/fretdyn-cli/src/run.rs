@@ -236,9 +236,9 @@ fn check_disk_to_resume(case: &Case, dir: &Path) -> Result<(), Failure> {
     let remaining = total.saturating_sub(written);
     let size = fretdyn::results::recorder::human_bytes;
     match disk_verdict(remaining, total, free) {
-        // every time history written: the packing starts at once, and says itself what
-        // stopped it
         DiskVerdict::Fits => Ok(()),
+        // every time history written: the packing starts at once, and says itself what
+        // stops it
         DiskVerdict::PackingShort if remaining == 0 => Ok(()),
         DiskVerdict::PackingShort => {
             errln!(

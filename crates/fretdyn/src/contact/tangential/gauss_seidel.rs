@@ -126,7 +126,7 @@ fn solve_by_sweeps(
 /// the first one's change does not pass the test, would return the same λ with a change of
 /// exactly 0 (counted, not recomputed: THEORY §4.4). The same operations as the loop of
 /// [`solve`], so the same bits and counts. `None` (λ and statuses as given) when the first
-/// sweep's λ is not finite: [`solve`] then runs its loop.
+/// sweep's λ is not finite: [`solve`] then sweeps ([`solve_by_sweeps`]).
 #[inline]
 fn solve_single_radial(
     settings: &GaussSeidelSettings,
@@ -150,7 +150,7 @@ fn solve_single_radial(
 /// and return the same λ to round-off — a few ulps of `|λ|`, a change that passes a tolerance
 /// of 1e-14 or more. It is counted, not recomputed (THEORY §4.4). `None` (λ and statuses as
 /// given) when the tolerance is below that, the first sweep's λ is not finite or misses the
-/// residual tolerance: [`solve`] then runs its loop.
+/// residual tolerance: [`solve`] then sweeps ([`solve_by_sweeps`]).
 #[inline]
 fn solve_single_exact(
     settings: &GaussSeidelSettings,
