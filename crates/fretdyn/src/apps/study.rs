@@ -19,7 +19,8 @@
 //! statistic = "wear_work_rate"
 //! ```
 //!
-//! A probabilistic study draws parameters from distributions ([`sampling`], `docs/STUDIES.md`):
+//! A probabilistic study draws parameters from distributions
+//! ([`sampling`](crate::apps::sampling), `docs/STUDIES.md`):
 //!
 //! ```toml
 //! base = "tube_multispan.toml"
@@ -36,8 +37,8 @@
 //! ```
 //!
 //! The runs are: every combination of the `values` parameters (grid or list) × every sample ×
-//! every seed, in that order; percentiles ([`percentiles`]) pool the samples and seeds of a
-//! combination.
+//! every seed, in that order; percentiles ([`percentiles`](crate::apps::percentiles)) pool the
+//! samples and seeds of a combination.
 
 use std::collections::BTreeSet;
 use std::io::Write;

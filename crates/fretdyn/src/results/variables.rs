@@ -1,7 +1,7 @@
 //! The one table of names, dimensions, units and long names of a run's time histories (the
 //! keys of `results.npz`, THEORY §5) and of the coordinates along their dimensions. Every
 //! self-describing output takes its metadata from here, and nowhere else: `results.nc`
-//! ([`crate::results::netcdf`]), the Python package's `Result.to_xarray()` and its plot labels
+//! (`crate::results::netcdf`), the Python package's `Result.to_xarray()` and its plot labels
 //! (`fretdyn.variables()`). `xarray.open_dataset("results.nc")` and `to_xarray()` are then the
 //! same Dataset.
 //!

@@ -343,7 +343,7 @@ pub fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
     crate::kernels::Portable::dot2(a, b, c)
 }
 
-/// `out += s x` on equal-length slices (the step's kernel, [`crate::kernels`]).
+/// `out += s x` on equal-length slices (the step's kernel, `crate::kernels`).
 #[inline(always)]
 pub fn axpy(out: &mut [f64], s: f64, x: &[f64]) {
     use crate::kernels::Lanes;

@@ -28,7 +28,7 @@ pub struct Sweeps {
 /// Solves the tangential problem from the λ given (warm start) and writes the statuses.
 ///
 /// A single closed contact, the common case of a rattling structure, is solved in line
-/// ([`solve_single_radial`], [`solve_single_exact`]); several by [`solve_by_sweeps`].
+/// (`solve_single_radial`, `solve_single_exact`); several by the sweeps (`solve_by_sweeps`).
 #[inline(always)]
 pub fn solve(
     settings: &GaussSeidelSettings,

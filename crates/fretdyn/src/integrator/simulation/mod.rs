@@ -651,7 +651,7 @@ impl<'m> Simulation<'m> {
     ///
     /// In the common case (every obstacle a fixed plane or fixed bars, an undamped normal law,
     /// friction by Lagrange multipliers) the phases that visit the contacts run as the same
-    /// code compiled for that case only ([`contact_kinds`], [`Self::runs_common_step`]): the
+    /// code compiled for that case only (`contact_kinds`, [`Self::runs_common_step`]): the
     /// same results bit for bit ([`Self::use_general_step`]).
     pub fn step(&mut self) -> std::result::Result<(), Divergence> {
         self.steps(1).map(|_| ())
@@ -689,7 +689,7 @@ impl<'m> Simulation<'m> {
     }
 
     /// Runs the steps with the code compiled for any contact even when the case is the
-    /// common one ([`contact_kinds`]): for comparisons and tests.
+    /// common one (`contact_kinds`): for comparisons and tests.
     pub fn use_general_step(&mut self) {
         self.common_contacts = false;
     }
