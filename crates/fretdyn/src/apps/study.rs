@@ -971,16 +971,15 @@ pub fn statistics_run(
     let total = settings.steps;
     let mut termination = Termination::Completed;
     while sim.steps_done() < total {
-        // to the next multiple of 1024 steps, where the finished impacts and blocks are let go
-        let n = sim.steps_done();
-        if let Err(d) = sim.steps((total - n).min(1024 - n % 1024)) {
+        // to the end of the batch, where the finished impacts and blocks are let go
+        if let Err(d) = sim.steps(sim.steps_to_batch_end(total)) {
             termination = d.into_termination(model);
             break;
         }
         if sim.recorder().is_full() {
             sim.recorder_mut().clear();
         }
-        if sim.steps_done() % 1024 == 0 {
+        if sim.steps_done() % Simulation::BATCH == 0 {
             let statistics = sim.statistics_mut();
             statistics.impacts.clear();
             statistics.blocks.clear();

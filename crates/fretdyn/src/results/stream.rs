@@ -304,10 +304,10 @@ fn drive(
     let mut termination = Termination::Completed;
     let model = files.model_contacts.clone();
     while sim.steps_done() < total && sim.target_met().is_none() {
-        // to the next multiple of 1024 steps or of the checkpoints' steps, where the loop
-        // below looks at the clock and the observer
+        // to the end of the batch or the next multiple of the checkpoints' steps, where the
+        // loop below looks at the clock and the observer
         let n = sim.steps_done();
-        let mut chunk = (total - n).min(1024 - n % 1024);
+        let mut chunk = sim.steps_to_batch_end(total);
         if let Some(every) = stream.checkpoint_every_steps.filter(|&e| e > 0) {
             chunk = chunk.min(every - n % every);
         }
@@ -326,7 +326,7 @@ fn drive(
         let by_steps = stream
             .checkpoint_every_steps
             .is_some_and(|every| every > 0 && n % every == 0);
-        if n % 1024 == 0 || by_steps {
+        if n % Simulation::BATCH == 0 || by_steps {
             let by_time = stream
                 .checkpoint_every_seconds
                 .is_some_and(|s| last_checkpoint.elapsed().as_secs_f64() >= s);
@@ -335,7 +335,7 @@ fn drive(
                 last_checkpoint = Instant::now();
                 observer.checkpoint(&partial(&sim, start));
             }
-            if n % 1024 == 0
+            if n % Simulation::BATCH == 0
                 && n < total
                 && observer.progress(Progress { step: n, total }).is_break()
             {

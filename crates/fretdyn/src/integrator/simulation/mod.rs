@@ -380,6 +380,17 @@ impl<'m> Simulation<'m> {
         self.step
     }
 
+    /// Steps between the run loops' looks at the progress, the clock and the finished rows
+    /// ([`Self::steps_to_batch_end`]).
+    pub const BATCH: u64 = 1024;
+
+    /// Steps from here to the next multiple of [`Self::BATCH`], or to `total` when it comes
+    /// first: what a run loop asks of [`Self::steps`] at a time.
+    pub fn steps_to_batch_end(&self, total: u64) -> u64 {
+        let n = self.step;
+        total.saturating_sub(n).min(Self::BATCH - n % Self::BATCH)
+    }
+
     /// Time reached, s.
     pub fn time(&self) -> f64 {
         self.step as f64 * self.settings.dt

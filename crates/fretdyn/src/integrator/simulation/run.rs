@@ -105,14 +105,16 @@ pub fn run(
     let total = settings.steps;
     let mut termination = Termination::Completed;
     while sim.steps_done() < total && sim.target_met().is_none() {
-        // to the next multiple of 1024 steps, where the observer is called
-        let n = sim.steps_done();
-        if let Err(d) = sim.steps((total - n).min(1024 - n % 1024)) {
+        // to the end of the batch, where the observer is called
+        if let Err(d) = sim.steps(sim.steps_to_batch_end(total)) {
             termination = d.into_termination(model);
             break;
         }
         let n = sim.steps_done();
-        if n % 1024 == 0 && n < total && observer(Progress { step: n, total }).is_break() {
+        if n % Simulation::BATCH == 0
+            && n < total
+            && observer(Progress { step: n, total }).is_break()
+        {
             termination = Termination::Stopped { step: n };
             break;
         }
