@@ -540,7 +540,8 @@ impl TangentialProblem {
     /// the others' λ fixed, by Cholesky on the `2|S|` unknowns. `work` must hold
     /// `(2m)² + 4m` values and `index` 2m. Returns true when `H_SS` was singular (a pivot below `1e-12`
     /// of the largest diagonal term), in which case a Tikhonov term of that size regularises
-    /// it (THEORY §4.6).
+    /// it (THEORY §4.6). A single stick slot is solved by its block's inverse
+    /// (THEORY §4.3).
     pub fn solve_stick(
         &self,
         stick: &[bool],
@@ -559,6 +560,14 @@ impl TangentialProblem {
         }
         if n == 0 {
             return false;
+        }
+        if n == 2 {
+            // One stick contact (the common case): its unknowns are its local problem's
+            // free solution `H_kk⁻¹ c_k`, with the inverse formed once per step
+            if let Some(x) = self.single_stick(index[0] / 2, lambda) {
+                lambda[index[0] / 2] = x;
+                return false;
+            }
         }
         let (a, rest) = work.split_at_mut(n * n);
         let (x, rest) = rest.split_at_mut(n);
@@ -585,6 +594,28 @@ impl TangentialProblem {
             lambda[index[i] / 2] = Vector2::new(x[i], x[i + 1]);
         }
         singular
+    }
+}
+
+impl TangentialProblem {
+    /// [`Self::solve_stick`] of the single stick slot `k`: `λ_k = H_kk⁻¹ c_k`, with
+    /// `c_k = b_k − Σ_{l≠k} H_kl λ_l`, by the block's inverse ([`DiagonalBlock`], formed
+    /// once per step) instead of a factorisation on the dependent chain of every status
+    /// iteration. `None` when `H_kk` is singular by either test, the Cholesky's (a pivot
+    /// `h₀₀` or `h₁₁ − h₀₁²/h₀₀` below `1e-12 max|h_ii|`, then regularised by the general
+    /// path) or [`inverse2`]'s (`det < 1e-13 max|h_ii|²`, whose pseudo-inverse is not the
+    /// regularised solution): the two then solve the same regular system, up to round-off.
+    #[inline]
+    fn single_stick(&self, k: usize, lambda: &[Vector2<f64>]) -> Option<Vector2<f64>> {
+        let block = self.diagonal_block(k);
+        let h = &block.h;
+        let (a, b, d) = (h[(0, 0)], h[(0, 1)], h[(1, 1)]);
+        let dmax = a.abs().max(d.abs());
+        let tiny = 1e-12 * dmax.max(f64::MIN_POSITIVE);
+        let det = a * d - b * h[(1, 0)];
+        // a > tiny and d − b²/a > tiny (times a > 0), and inverse2's regular branch
+        let regular = a > tiny && det > a * tiny && det > 1e-13 * dmax * dmax;
+        regular.then(|| block.inverse() * self.local_rhs(k, lambda))
     }
 }
 
@@ -756,6 +787,57 @@ mod tests {
                 assert_eq!(problem.b[r].to_bits(), fresh.b[r].to_bits());
             }
         }
+    }
+
+    /// A single stick contact is solved by its block's inverse: the stick condition
+    /// `(b − Hλ)_k = 0` holds to round-off, as the Cholesky of the general path makes it;
+    /// with two stick contacts (the general path) the same holds for both.
+    #[test]
+    fn a_single_stick_contact_has_zero_slip_velocity() {
+        let mut problem = fixed_problem();
+        closed(&mut problem, &[0, 1, 2]);
+        let (mut work, mut index) = (vec![0.0; 36 + 12], vec![0; 6]);
+        for stick in [
+            [true, false, false],
+            [false, true, false],
+            [false, false, true],
+            [true, false, true],
+        ] {
+            let mut lambda = [
+                Vector2::new(0.3, -0.1),
+                Vector2::new(-0.2, 0.25),
+                Vector2::new(0.05, 0.4),
+            ];
+            let frozen = lambda;
+            assert!(!problem.solve_stick(&stick, &mut lambda, &mut work, &mut index));
+            for k in 0..3 {
+                if stick[k] {
+                    let w = problem.residual_velocity(k, &lambda);
+                    let scale =
+                        problem.rhs(k).norm() + problem.block(k, k).norm() * lambda[k].norm();
+                    assert!(w.norm() <= 1e-14 * scale, "{stick:?}: w_{k} = {w}");
+                } else {
+                    assert_eq!(lambda[k], frozen[k], "a sliding contact's λ is not touched");
+                }
+            }
+        }
+    }
+
+    /// A stick contact whose block is singular (its two tangent rows equal) is not solved by
+    /// the inverse: the general path regularises it and says so.
+    #[test]
+    fn a_singular_single_stick_block_goes_to_the_regularised_path() {
+        let (p, contacts) = (4, 1);
+        let mut problem = TangentialProblem::new(p, contacts);
+        let t = Vector3::new(0.0, 0.6, 0.8);
+        let rows: Vec<f64> = (0..3 * p).map(|i| ((i * 5) % 7) as f64 - 2.5).collect();
+        problem.fix_rows(0, &[t, t], &rows, |l, out| out.copy_from_slice(l));
+        closed(&mut problem, &[0]);
+        assert!(problem.single_stick(0, &[Vector2::zeros()]).is_none());
+        let (mut work, mut index) = (vec![0.0; 8], vec![0; 2]);
+        let mut lambda = [Vector2::zeros()];
+        assert!(problem.solve_stick(&[true], &mut lambda, &mut work, &mut index));
+        assert!(lambda[0].x.is_finite() && lambda[0].y.is_finite());
     }
 
     #[test]

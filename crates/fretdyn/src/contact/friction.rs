@@ -95,6 +95,12 @@ impl DiagonalBlock {
         }
     }
 
+    /// `H_ii⁻¹` ([`inverse2`]: the pseudo-inverse when `H_ii` is singular).
+    #[inline]
+    pub fn inverse(&self) -> &Matrix2<f64> {
+        &self.inverse
+    }
+
     /// The step `ρ = 2/tr(H_ii)` of the natural map (THEORY §4.2), 0 for a zero block.
     #[inline]
     pub fn rho(&self) -> f64 {

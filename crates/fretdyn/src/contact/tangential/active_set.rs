@@ -4,7 +4,8 @@
 //! 1. initial statuses from the previous step (stick stays stick; slip keeps its direction;
 //!    a newly closed contact is guessed sliding along `b_i`, §4.5);
 //! 2. slip contacts: `λ_i = μ_d R_N,i d_i`;
-//! 3. stick contacts: `H_SS λ_S = b_S − H_SF λ_F` by Cholesky (regularised when singular, §4.6);
+//! 3. stick contacts: `H_SS λ_S = b_S − H_SF λ_F` by Cholesky (regularised when singular, §4.6;
+//!    a single one by its block's inverse);
 //! 4. each contact's status is then tested on its own local problem, the others frozen
 //!    (right-hand side `c_i = b_i − Σ_{j≠i} H_ij λ_j`, exact local solve of §4.4):
 //!    stick with `|λ_i| > μ_s R_N,i` → slip; slip whose local problem is a stick (for an
