@@ -562,8 +562,8 @@ impl TangentialProblem {
             return false;
         }
         if n == 2 {
-            // One stick contact (the common case): its unknowns are its local problem's
-            // free solution `H_kk⁻¹ c_k`, with the inverse formed once per step
+            // one stick contact (a structure that sticks, mostly): its unknowns are its
+            // local problem's free solution `H_kk⁻¹ c_k`, the inverse formed once per step
             if let Some(x) = self.single_stick(index[0] / 2, lambda) {
                 lambda[index[0] / 2] = x;
                 return false;
@@ -595,9 +595,7 @@ impl TangentialProblem {
         }
         singular
     }
-}
 
-impl TangentialProblem {
     /// [`Self::solve_stick`] of the single stick slot `k`: `λ_k = H_kk⁻¹ c_k`, with
     /// `c_k = b_k − Σ_{l≠k} H_kl λ_l`, by the block's inverse ([`DiagonalBlock`], formed
     /// once per step) instead of a factorisation on the dependent chain of every status
