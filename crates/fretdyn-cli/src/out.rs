@@ -36,7 +36,7 @@ pub fn error_line(args: std::fmt::Arguments) {
     let _ = err.write_fmt(args).and_then(|_| err.write_all(b"\n"));
 }
 
-/// `println!` that returns `Result<(), Failure>` instead of panicking ([`line`]).
+/// `println!` that returns `Result<(), Failure>` instead of panicking ([`line()`]).
 macro_rules! outln {
     ($($arg:tt)*) => {
         $crate::out::line(format_args!($($arg)*))

@@ -69,6 +69,8 @@ pub struct TangentialProblem {
     h_for: Vec<usize>,
     /// Whether the local solves are exact ([`Self::set_exact_local_solve`]).
     exact: bool,
+    /// Whether every slot's rows are fixed (kept by [`Self::clear`] and [`Self::push_with`]).
+    all_fixed: bool,
 }
 
 impl TangentialProblem {
@@ -94,6 +96,7 @@ impl TangentialProblem {
             singular: None,
             h_for: Vec::with_capacity(contacts),
             exact: true,
+            all_fixed: true,
         }
     }
 
@@ -112,6 +115,7 @@ impl TangentialProblem {
         self.h_for.clear();
         self.compute_rows(contact, tangents, rows, apply_a_inv);
         self.fixed[contact] = true;
+        self.all_fixed = self.slots.iter().all(|s| self.fixed[s.contact]);
         let p = self.p;
         for other in 0..self.fixed.len() {
             if !self.fixed[other] {
@@ -173,6 +177,7 @@ impl TangentialProblem {
     #[inline]
     pub fn clear(&mut self) {
         self.slots.clear();
+        self.all_fixed = true;
     }
 
     /// Number of closed contacts `m` (the problem has `2m` unknowns).
@@ -217,6 +222,7 @@ impl TangentialProblem {
     ) {
         if !self.fixed[slot.contact] {
             self.compute_rows(slot.contact, tangents, rows, apply_a_inv);
+            self.all_fixed = false;
         }
         self.slots.push(slot);
     }
@@ -249,7 +255,7 @@ impl TangentialProblem {
         let inverse_theta_dt = 1.0 / theta_dt;
         // H of fixed rows depends only on which contacts are closed: the one in `h` serves
         // while they stay the same (a contact stays closed for many steps)
-        let all_fixed = self.slots.iter().all(|s| self.fixed[s.contact]);
+        let all_fixed = self.all_fixed;
         let h_kept = all_fixed && same_contacts(&self.h_for, &self.slots);
         if !h_kept {
             self.h_for.clear();
@@ -417,13 +423,6 @@ impl TangentialProblem {
         self.sweep[k].set([rhs, change]);
     }
 
-    /// Slot `k`'s last recorded local solve: its right-hand side and change
-    /// ([`Self::record_sweep`]).
-    #[inline]
-    pub fn recorded_sweep(&self, k: usize) -> [Vector2<f64>; 2] {
-        self.sweep[k].get()
-    }
-
     /// [`Self::natural_map_residual`] at the end of a Gauss–Seidel sweep whose every local
     /// solve was recorded ([`Self::record_sweep`]), without forming `Hλ` again: slot `k`'s
     /// right-hand side saw the new λ of the slots before it and the old λ of those after it,
@@ -506,7 +505,7 @@ impl TangentialProblem {
         if n == 0 {
             return false;
         }
-        let all_fixed = self.slots.iter().all(|s| self.fixed[s.contact]);
+        let all_fixed = self.all_fixed;
         if all_fixed && self.singular.is_some() && same_contacts(&self.singular_for, &self.slots) {
             return self.singular == Some(true);
         }

@@ -93,22 +93,6 @@ fn solve_by_sweeps(
                     residual,
                 };
             }
-        } else if m == 1
-            && settings.local_solve == LocalSolve::Radial
-            && sweep < settings.max_sweeps
-            && norm2.is_finite()
-        {
-            // A single contact: the next sweep solves the same local problem (no other λ
-            // changed its right-hand side), and the radial solve returns the same λ, a
-            // change of exactly 0 that passes the test. It is counted, not recomputed
-            // (THEORY §4.4).
-            let [c, _] = problem.recorded_sweep(0);
-            problem.record_sweep(0, c, Vector2::zeros());
-            return Sweeps {
-                count: sweep + 1,
-                converged: true,
-                residual: Some(problem.natural_map_residual_after_sweep(&lambda[..m], &slide[..m])),
-            };
         } else {
             residual = None;
         }
