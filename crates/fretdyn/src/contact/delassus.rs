@@ -143,6 +143,7 @@ impl TangentialProblem {
         self.diagonal_fixed[contact] = DiagonalBlock::new(h, true);
     }
 
+    #[inline(always)]
     fn compute_rows(
         &mut self,
         contact: usize,
@@ -151,11 +152,14 @@ impl TangentialProblem {
         apply_a_inv: impl Fn(&[f64], &mut [f64]),
     ) {
         let p = self.p;
+        // slices of equal length: no bounds checks, and the loop vectorises
+        let (x, rest) = rows[..3 * p].split_at(p);
+        let (y, z) = rest.split_at(p);
         for (a, t) in tangents.iter().enumerate() {
             let r = 2 * contact + a;
             let l = &mut self.l[r * p..(r + 1) * p];
-            for i in 0..p {
-                l[i] = t.x * rows[i] + t.y * rows[p + i] + t.z * rows[2 * p + i];
+            for (((l, x), y), z) in l.iter_mut().zip(x).zip(y).zip(z) {
+                *l = t.x * x + t.y * y + t.z * z;
             }
             apply_a_inv(l, &mut self.al[r * p..(r + 1) * p]);
         }
@@ -493,8 +497,9 @@ impl TangentialProblem {
         }
     }
 
-    /// Whether `H` is singular (redundant constraints, THEORY §4.6): a Cholesky pivot below
-    /// `1e-12` of the largest diagonal term. `work` must hold `(2m)² + 4m` values.
+    /// Whether `H` is singular (redundant constraints, THEORY §4.6): a pivot of its `LDLᵀ`
+    /// factorisation (the Cholesky's, before its square root) below `1e-12` of the largest
+    /// diagonal term. `work` must hold `(2m)² + 4m` values.
     ///
     /// When every closed contact's rows are fixed (planes, bars), `H` depends only on which
     /// contacts are closed: the factorisation is then redone only when that set changes
@@ -519,20 +524,18 @@ impl TangentialProblem {
         singular
     }
 
+    /// The pivot test of [`Self::is_singular`] on the current `H`: its lower triangle into
+    /// `work`, then [`ldlt_singular`] with `tiny = 1e-12 max|H_ii|`.
     fn factor_singular(&self, work: &mut [f64], n: usize) -> bool {
         let (a, rest) = work.split_at_mut(n * n);
-        let (x, rest) = rest.split_at_mut(n);
-        let diag = &mut rest[..n];
         let mut dmax = 0.0f64;
         for i in 0..n {
-            for j in 0..n {
+            for j in 0..=i {
                 a[i * n + j] = self.h(i, j);
             }
-            diag[i] = a[i * n + i];
-            dmax = dmax.max(diag[i].abs());
-            x[i] = 0.0;
+            dmax = dmax.max(a[i * n + i].abs());
         }
-        cholesky_solve(a, diag, x, n, 1e-12 * dmax.max(f64::MIN_POSITIVE))
+        ldlt_singular(a, &mut rest[..n], n, 1e-12 * dmax.max(f64::MIN_POSITIVE))
     }
 
     /// Solves `H_SS λ_S = b_S − H_SF λ_F` for the stick slots `S` (those with `stick[k]`),
@@ -614,6 +617,39 @@ impl TangentialProblem {
         let regular = a > tiny && det > a * tiny && det > 1e-13 * dmax * dmax;
         regular.then(|| block.inverse() * self.local_rhs(k, lambda))
     }
+}
+
+/// Whether the symmetric `n × n` matrix whose lower triangle (diagonal included) is in `a`
+/// has a pivot of its `LDLᵀ` factorisation at most `tiny` (or not a number): the Cholesky's
+/// pivot test (its pivots before their square roots, `d_j = a_jj − Σ_k l_jk² d_k`) without its
+/// square roots, its divisions but one per column, and a solve — what a singularity test
+/// needs (THEORY §4.6). `a` is overwritten; `inverse_pivots` holds `n` values.
+fn ldlt_singular(a: &mut [f64], inverse_pivots: &mut [f64], n: usize, tiny: f64) -> bool {
+    for j in 0..n {
+        let (done, row) = a.split_at_mut(j * n);
+        let row = &mut row[..j + 1];
+        // u_jk = l_jk d_k = a_jk − Σ_{i<k} u_ji l_ki, row k (< j) holding l_k·
+        for k in 0..j {
+            let lk = &done[k * n..k * n + k];
+            let mut u = row[k];
+            for (ui, li) in row[..k].iter().zip(lk) {
+                u -= ui * li;
+            }
+            row[k] = u;
+        }
+        // d_j = a_jj − Σ_k u_jk l_jk, and row j turned into l_j·
+        let mut d = row[j];
+        for k in 0..j {
+            let l = row[k] * inverse_pivots[k];
+            d -= row[k] * l;
+            row[k] = l;
+        }
+        if !(d > tiny) {
+            return true;
+        }
+        inverse_pivots[j] = 1.0 / d;
+    }
+    false
 }
 
 /// In-place Cholesky solve of the SPD `n × n` system `a x = rhs` (rhs overwritten by x).
@@ -835,6 +871,57 @@ mod tests {
         let mut lambda = [Vector2::zeros()];
         assert!(problem.solve_stick(&[true], &mut lambda, &mut work, &mut index));
         assert!(lambda[0].x.is_finite() && lambda[0].y.is_finite());
+    }
+
+    /// The square-root-free pivot test gives the Cholesky's answer: regular for SPD matrices
+    /// (down to a smallest eigenvalue 1e-9 of the largest, at scales 1e-6 to 1e6), singular for a
+    /// rank-deficient one (two contacts with the same rows), a pivot just below the
+    /// threshold, and a NaN.
+    #[test]
+    fn ldlt_pivots_flag_what_the_cholesky_flags() {
+        let test = |spd: &nalgebra::DMatrix<f64>| {
+            let n = spd.nrows();
+            let dmax = (0..n).map(|i| spd[(i, i)].abs()).fold(0.0, f64::max);
+            let tiny = 1e-12 * dmax;
+            let mut a: Vec<f64> = (0..n * n).map(|k| spd[(k / n, k % n)]).collect();
+            let mut inverse_pivots = vec![0.0; n];
+            let ldlt = ldlt_singular(&mut a, &mut inverse_pivots, n, tiny);
+            let mut a: Vec<f64> = (0..n * n).map(|k| spd[(k / n, k % n)]).collect();
+            let diag: Vec<f64> = (0..n).map(|i| spd[(i, i)]).collect();
+            let cholesky = cholesky_solve(&mut a, &diag, &mut vec![0.0; n], n, tiny);
+            assert_eq!(ldlt, cholesky, "{spd}");
+            ldlt
+        };
+        for n in [2, 4, 6] {
+            let m =
+                nalgebra::DMatrix::<f64>::from_fn(n, n, |i, j| ((i * 7 + j * 3) % 5) as f64 + 0.3);
+            for smallest in [1.0f64, 1e-3, 1e-9] {
+                // Q diag Qᵀ with eigenvalues from 1 down to `smallest`
+                let q = m.clone().qr().q();
+                let d =
+                    nalgebra::DVector::from_fn(n, |i, _| smallest.powf(i as f64 / (n - 1) as f64));
+                let spd = &q * nalgebra::DMatrix::from_diagonal(&d) * q.transpose();
+                for scale in [1e-6, 1.0, 1e6] {
+                    assert!(!test(&(&spd * scale)));
+                }
+            }
+            // two contacts with the same rows: H = L Lᵀ with repeated rows of L
+            let mut l =
+                nalgebra::DMatrix::<f64>::from_fn(n, 8, |i, j| ((i * 5 + j * 11) % 7) as f64 - 3.0);
+            for j in 0..8 {
+                l[(n - 1, j)] = l[(0, j)];
+            }
+            assert!(test(&(&l * l.transpose())));
+        }
+        // the second pivot 1 − 0.99999999999999² ≈ 2e-14 below 1e-12: singular
+        let near = nalgebra::DMatrix::from_row_slice(
+            2,
+            2,
+            &[1.0, 0.99999999999999, 0.99999999999999, 1.0],
+        );
+        assert!(test(&near));
+        let mut a = vec![1.0, 0.0, 0.0, f64::NAN];
+        assert!(ldlt_singular(&mut a, &mut [0.0; 2], 2, 1e-12));
     }
 
     #[test]

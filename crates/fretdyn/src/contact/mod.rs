@@ -147,15 +147,23 @@ impl Contact {
 
     /// Rows (3 × p) of the contact point on the surface for the normal `n`:
     /// `Φ_u + R [n]_× Θ`, from the point's translation rows `Φ_u` and rotation rows `Θ`.
-    #[inline]
+    #[inline(always)]
     pub fn surface_rows(&self, point: &Point, n: &Vector3<f64>, out: &mut [f64]) {
         let p = out.len() / 3;
-        let (u, th, r) = (&point.rows, &point.rotations, self.radius);
-        for i in 0..p {
-            let (tx, ty, tz) = (th[i], th[p + i], th[2 * p + i]);
-            out[i] = u[i] + r * (n.y * tz - n.z * ty);
-            out[p + i] = u[p + i] + r * (n.z * tx - n.x * tz);
-            out[2 * p + i] = u[2 * p + i] + r * (n.x * ty - n.y * tx);
+        let r = self.radius;
+        // slices of equal length: no bounds checks, and the loops vectorise
+        let [ux, uy, uz] = thirds(&point.rows, p);
+        let [tx, ty, tz] = thirds(&point.rotations, p);
+        let (ox, rest) = out[..3 * p].split_at_mut(p);
+        let (oy, oz) = rest.split_at_mut(p);
+        for (((o, u), a), b) in ox.iter_mut().zip(ux).zip(tz).zip(ty) {
+            *o = u + r * (n.y * a - n.z * b);
+        }
+        for (((o, u), a), b) in oy.iter_mut().zip(uy).zip(tx).zip(tz) {
+            *o = u + r * (n.z * a - n.x * b);
+        }
+        for (((o, u), a), b) in oz.iter_mut().zip(uz).zip(ty).zip(tx) {
+            *o = u + r * (n.x * a - n.y * b);
         }
     }
 
@@ -190,4 +198,12 @@ impl Contact {
         }
         self.motion.validate(&format!("{field}.motion"))
     }
+}
+
+/// The three rows (x, y, z) of `p` values each of a 3 × p block.
+#[inline(always)]
+fn thirds(rows: &[f64], p: usize) -> [&[f64]; 3] {
+    let (x, rest) = rows[..3 * p].split_at(p);
+    let (y, z) = rest.split_at(p);
+    [x, y, z]
 }

@@ -192,8 +192,8 @@ impl CentralDifference {
     pub fn apply_a_inv(&self, l: &[f64], out: &mut [f64]) {
         match &self.operators {
             Operators::Modal { a_inv, .. } => {
-                for i in 0..l.len() {
-                    out[i] = a_inv[i] * l[i];
+                for ((o, a), l) in out.iter_mut().zip(a_inv).zip(l) {
+                    *o = a * l;
                 }
             }
             Operators::Dense { a_inv, .. } => mat_vec(a_inv, l, out),
