@@ -525,8 +525,18 @@ impl TangentialProblem {
     }
 
     /// The pivot test of [`Self::is_singular`] on the current `H`: its lower triangle into
-    /// `work`, then [`ldlt_singular`] with `tiny = 1e-12 max|H_ii|`.
+    /// `work`, then [`ldlt_singular`] with `tiny = 1e-12 max|H_ii|` (a 2 × 2 `H` in line).
     fn factor_singular(&self, work: &mut [f64], n: usize) -> bool {
+        if n == 2 {
+            // a single contact, the common case: the same operations without the gathering
+            let (a00, a10, a11) = (self.h(0, 0), self.h(1, 0), self.h(1, 1));
+            let tiny = 1e-12 * a00.abs().max(a11.abs()).max(f64::MIN_POSITIVE);
+            if !(a00 > tiny) {
+                return true;
+            }
+            let l = a10 * (1.0 / a00);
+            return !(a11 - a10 * l > tiny);
+        }
         let (a, rest) = work.split_at_mut(n * n);
         let mut dmax = 0.0f64;
         for i in 0..n {
@@ -772,6 +782,38 @@ mod tests {
             });
         }
         problem
+    }
+
+    /// A single contact's singularity test, in line, answers as the general `LDLᵀ` path on its
+    /// 2 × 2 `H`: regular, rank 1 (the two tangent rows equal), and the tangent rows
+    /// 1e-5 and 1e-7 apart (second pivots ~2e-11 and ~2e-15 of the first, against 1e-12).
+    #[test]
+    fn a_single_contact_singularity_test_answers_as_the_general_one() {
+        let p = 3;
+        let a_inv = [0.5, 1.5, 2.0];
+        for (gap, expected) in [(1.0, false), (0.0, true), (1e-5, false), (1e-7, true)] {
+            let mut problem = TangentialProblem::new(p, 1);
+            // rows of the point (3 × p): x, y, z; tangents x and (y + gap)-ish
+            let rows = [1.0, 2.0, -1.0, 1.0, 2.0 + gap, -1.0, 0.3, 0.1, 0.7];
+            let tangents = [Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.0, 1.0, 0.0)];
+            let slot = Slot {
+                contact: 0,
+                s_static: 1.0,
+                s_dynamic: 0.8,
+            };
+            problem.push(slot, &tangents, &rows, &a_inv);
+            problem.assemble(&[0.0; 3], &[0.0; 3], 1e-3, |_| Vector2::zeros());
+            let mut work = vec![0.0; 16];
+            let inline = problem.is_singular(&mut work);
+            let mut a = [problem.h(0, 0), 0.0, problem.h(1, 0), problem.h(1, 1)];
+            let tiny = 1e-12 * problem.h(0, 0).abs().max(problem.h(1, 1).abs());
+            assert_eq!(
+                inline,
+                ldlt_singular(&mut a, &mut [0.0; 2], 2, tiny),
+                "gap {gap}"
+            );
+            assert_eq!(inline, expected, "gap {gap}");
+        }
     }
 
     fn closed(problem: &mut TangentialProblem, contacts: &[usize]) {
