@@ -631,9 +631,9 @@ impl TangentialProblem {
 
 /// Whether the symmetric `n × n` matrix whose lower triangle (diagonal included) is in `a`
 /// has a pivot of its `LDLᵀ` factorisation at most `tiny` (or not a number): the Cholesky's
-/// pivot test (its pivots before their square roots, `d_j = a_jj − Σ_k l_jk² d_k`) without its
-/// square roots, its divisions but one per column, and a solve — what a singularity test
-/// needs (THEORY §4.6). `a` is overwritten; `inverse_pivots` holds `n` values.
+/// pivot test (its pivots before their square roots, `d_j = a_jj − Σ_k l_jk² d_k`) with no
+/// square root, one division per column and no solve — what a singularity test needs
+/// (THEORY §4.6). `a` is overwritten; `inverse_pivots` holds `n` values.
 fn ldlt_singular(a: &mut [f64], inverse_pivots: &mut [f64], n: usize, tiny: f64) -> bool {
     for j in 0..n {
         let (done, row) = a.split_at_mut(j * n);
@@ -793,7 +793,8 @@ mod tests {
         let a_inv = [0.5, 1.5, 2.0];
         for (gap, expected) in [(1.0, false), (0.0, true), (1e-5, false), (1e-7, true)] {
             let mut problem = TangentialProblem::new(p, 1);
-            // rows of the point (3 × p): x, y, z; tangents x and (y + gap)-ish
+            // the point's rows (3 × p): its x and y rows differ by `gap` in one entry, and
+            // the tangents x and y make them the two rows of L
             let rows = [1.0, 2.0, -1.0, 1.0, 2.0 + gap, -1.0, 0.3, 0.1, 0.7];
             let tangents = [Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.0, 1.0, 0.0)];
             let slot = Slot {
