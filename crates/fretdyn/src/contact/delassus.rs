@@ -20,6 +20,7 @@ use nalgebra::{Matrix2, Vector2, Vector3};
 
 use crate::contact::friction::{DiagonalBlock, Slide};
 use crate::kernels::{Lanes, Portable};
+use crate::structure::modal::thirds;
 
 /// One closed contact in the tangential problem.
 #[derive(Debug, Clone, Copy, Default)]
@@ -152,9 +153,7 @@ impl TangentialProblem {
         apply_a_inv: impl Fn(&[f64], &mut [f64]),
     ) {
         let p = self.p;
-        // slices of equal length: no bounds checks, and the loop vectorises
-        let (x, rest) = rows[..3 * p].split_at(p);
-        let (y, z) = rest.split_at(p);
+        let [x, y, z] = thirds(rows, p);
         for (a, t) in tangents.iter().enumerate() {
             let r = 2 * contact + a;
             let l = &mut self.l[r * p..(r + 1) * p];
@@ -528,14 +527,10 @@ impl TangentialProblem {
     /// `work`, then [`ldlt_singular`] with `tiny = 1e-12 max|H_ii|` (a 2 × 2 `H` in line).
     fn factor_singular(&self, work: &mut [f64], n: usize) -> bool {
         if n == 2 {
-            // a single contact, the common case: the same operations without the gathering
+            // a single contact, the common case: its lower triangle on the stack
             let (a00, a10, a11) = (self.h(0, 0), self.h(1, 0), self.h(1, 1));
             let tiny = 1e-12 * a00.abs().max(a11.abs()).max(f64::MIN_POSITIVE);
-            if !(a00 > tiny) {
-                return true;
-            }
-            let l = a10 * (1.0 / a00);
-            return !(a11 - a10 * l > tiny);
+            return ldlt_singular(&mut [a00, 0.0, a10, a11], &mut [0.0; 2], 2, tiny);
         }
         let (a, rest) = work.split_at_mut(n * n);
         let mut dmax = 0.0f64;
@@ -634,6 +629,7 @@ impl TangentialProblem {
 /// pivot test (its pivots before their square roots, `d_j = a_jj − Σ_k l_jk² d_k`) with no
 /// square root, one division per column and no solve — what a singularity test needs
 /// (THEORY §4.6). `a` is overwritten; `inverse_pivots` holds `n` values.
+#[inline(always)]
 fn ldlt_singular(a: &mut [f64], inverse_pivots: &mut [f64], n: usize, tiny: f64) -> bool {
     for j in 0..n {
         let (done, row) = a.split_at_mut(j * n);

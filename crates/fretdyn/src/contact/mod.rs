@@ -30,7 +30,7 @@ use nalgebra::Vector3;
 
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::{ContactFrame, Obstacle};
-use crate::structure::modal::Point;
+use crate::structure::modal::{Point, thirds};
 
 /// Normal penalty law `R_N = max(0, K_N δ + C_N δ̇)` for `δ > 0`, `R_N = 0` otherwise (THEORY §3).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -198,12 +198,4 @@ impl Contact {
         }
         self.motion.validate(&format!("{field}.motion"))
     }
-}
-
-/// The three rows (x, y, z) of `p` values each of a 3 × p block.
-#[inline(always)]
-fn thirds(rows: &[f64], p: usize) -> [&[f64]; 3] {
-    let (x, rest) = rows[..3 * p].split_at(p);
-    let (y, z) = rest.split_at(p);
-    [x, y, z]
 }

@@ -300,6 +300,15 @@ pub(crate) fn check_damping_ratio(xi: f64, field: &str) -> Result<()> {
     }
 }
 
+/// The three rows (x, y, z) of one point's 3 × p rows, as slices of equal length (loops over
+/// them need no bounds checks and vectorise).
+#[inline(always)]
+pub(crate) fn thirds(rows: &[f64], p: usize) -> [&[f64]; 3] {
+    let (x, rest) = rows[..3 * p].split_at(p);
+    let (y, z) = rest.split_at(p);
+    [x, y, z]
+}
+
 /// `u = Φ_c x` for one point's 3 × p rows.
 #[inline(always)]
 pub fn recombine(rows: &[f64], x: &[f64]) -> Vector3<f64> {
