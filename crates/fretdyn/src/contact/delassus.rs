@@ -68,8 +68,6 @@ pub struct TangentialProblem {
     /// The closed contacts whose `H`, made of fixed rows only, is in `h` (empty: none):
     /// [`Self::assemble`] gathers it again only when they change.
     h_for: Vec<usize>,
-    /// Whether the local solves are exact ([`Self::set_exact_local_solve`]).
-    exact: bool,
     /// Whether every slot's rows are fixed (kept by [`Self::clear`] and [`Self::push_with`]).
     all_fixed: bool,
 }
@@ -96,7 +94,6 @@ impl TangentialProblem {
             singular_for: Vec::with_capacity(contacts),
             singular: None,
             h_for: Vec::with_capacity(contacts),
-            exact: true,
             all_fixed: true,
         }
     }
@@ -162,12 +159,6 @@ impl TangentialProblem {
             }
             apply_a_inv(l, &mut self.al[r * p..(r + 1) * p]);
         }
-    }
-
-    /// Whether the local solves of the diagonal blocks are exact (the default: their
-    /// eigen-decomposition is then prepared with them) or the radial projection.
-    pub fn set_exact_local_solve(&mut self, exact: bool) {
-        self.exact = exact;
     }
 
     /// Row of `L` (in the per-contact layout) of slot row `r`.
@@ -313,7 +304,7 @@ impl TangentialProblem {
             self.newton[k].set(f64::NAN);
             if !fixed_k {
                 // a fixed contact's block was prepared once ([`Self::diagonal_block`])
-                self.diagonal[k] = DiagonalBlock::new(self.block(k, k), self.exact);
+                self.diagonal[k] = DiagonalBlock::new(self.block(k, k), false);
             }
         }
     }

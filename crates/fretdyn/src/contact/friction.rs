@@ -64,34 +64,49 @@ pub enum LocalSolve {
 
 /// A contact's 2 × 2 diagonal block `H_ii` of the Delassus operator with what its local solve
 /// needs of it: its inverse ([`inverse2`]) and its eigen-decomposition, formed once per step
-/// rather than at every sweep.
-#[derive(Debug, Clone, Copy)]
+/// rather than at every sweep — the eigen-decomposition (two square roots, two divisions)
+/// only when an exact slip solve first asks for it, so that a sticking contact, or the
+/// radial projection, never pays for it.
+#[derive(Debug, Clone)]
 pub struct DiagonalBlock {
     /// `H_ii`.
     pub h: Matrix2<f64>,
     inverse: Matrix2<f64>,
-    /// The eigen-decomposition `H = Q diag(h) Qᵀ`, for the exact slip solution (not formed
-    /// for the radial projection, which does not need it).
-    eigen: Option<(Matrix2<f64>, [f64; 2])>,
+    /// The eigen-decomposition `H = Q diag(h) Qᵀ` for the exact slip solution, once formed.
+    eigen: Cell<Option<(Matrix2<f64>, [f64; 2])>>,
     isotropic: bool,
     /// `2/tr(H_ii)` ([`Self::rho`]).
     rho: f64,
 }
 
 impl DiagonalBlock {
-    /// The block `h` (symmetric positive semi-definite); `exact` when the exact local solve
-    /// will be asked of it.
+    /// The block `h` (symmetric positive semi-definite). `eager`: its eigen-decomposition is
+    /// formed now (a block that serves a whole run); otherwise at its first exact slip solve.
     #[inline]
-    pub fn new(h: Matrix2<f64>, exact: bool) -> Self {
+    pub fn new(h: Matrix2<f64>, eager: bool) -> Self {
         Self {
             h,
             inverse: inverse2(&h),
-            eigen: exact.then(|| symmetric_eigen2(&h)),
+            eigen: Cell::new(eager.then(|| symmetric_eigen2(&h))),
             isotropic: is_isotropic(&h),
             rho: {
                 let trace = h[(0, 0)] + h[(1, 1)];
                 if trace > 0.0 { 2.0 / trace } else { 0.0 }
             },
+        }
+    }
+
+    /// The eigen-decomposition `H = Q diag(h) Qᵀ` ([`symmetric_eigen2`]), formed at the first
+    /// call and kept.
+    #[inline(always)]
+    fn eigen(&self) -> (Matrix2<f64>, [f64; 2]) {
+        match self.eigen.get() {
+            Some(e) => e,
+            None => {
+                let e = symmetric_eigen2(&self.h);
+                self.eigen.set(Some(e));
+                e
+            }
         }
     }
 
@@ -238,7 +253,7 @@ fn disk_boundary_solve(
     newton: &Cell<f64>,
 ) -> Vector2<f64> {
     let h = &block.h;
-    let (q, eigenvalues) = block.eigen.unwrap_or_else(|| symmetric_eigen2(h));
+    let (q, eigenvalues) = block.eigen();
     let hs = [s * eigenvalues[0], s * eigenvalues[1]];
     let cp = q.transpose() * c;
     let c2 = [cp[0] * cp[0], cp[1] * cp[1]];
@@ -456,6 +471,28 @@ mod tests {
             })
             .fold(f64::INFINITY, f64::min);
         assert!(f(lam) <= best + 1e-9);
+    }
+
+    /// A lazy block forms its eigen-decomposition at its first exact slip solve only (not for
+    /// a stick, nor for the radial projection), and its solves give the bits of an eager
+    /// block's.
+    #[test]
+    fn eigen_decomposition_is_formed_at_the_first_exact_slip() {
+        let h = Matrix2::new(2.0, 0.7, 0.7, 0.5);
+        let (lazy, eager) = (DiagonalBlock::new(h, false), DiagonalBlock::new(h, true));
+        let start = || Cell::new(f64::NAN);
+        let c = Vector2::new(3.0, -1.0);
+        let (_, st) = local_solve_block(&lazy, &(c * 1e-3), 1.0, 0.5, LocalSolve::Exact, &start());
+        assert_eq!(st, Slide::Stick);
+        let (_, st) = local_solve_block(&lazy, &c, 0.4, 0.4, LocalSolve::Radial, &start());
+        assert_eq!(st, Slide::Slip);
+        assert!(lazy.eigen.get().is_none());
+        let from_lazy = local_solve_block(&lazy, &c, 0.4, 0.4, LocalSolve::Exact, &start());
+        assert!(lazy.eigen.get().is_some());
+        assert_eq!(lazy.eigen.get(), eager.eigen.get());
+        let from_eager = local_solve_block(&eager, &c, 0.4, 0.4, LocalSolve::Exact, &start());
+        assert_eq!(from_lazy, from_eager);
+        assert_eq!(from_lazy.1, Slide::Slip);
     }
 
     #[test]

@@ -5,6 +5,7 @@ use super::contact_kinds::ContactKinds;
 use super::{ContactState, RunResults, Simulation, Termination};
 use crate::contact::frame_rows::FrameRows;
 use crate::contact::friction::Slide;
+use crate::kernels::Lanes;
 use crate::results::recorder::{ContactSample, Recorder};
 use crate::results::statistics::{ContactStep, StepValues};
 use crate::structure::modal::recombine;
@@ -15,14 +16,14 @@ impl Simulation<'_> {
     /// `modal`: the structure's energy, modal damping power and external power
     /// ([`crate::integrator::central_difference::CentralDifference::energy_and_powers`]).
     #[inline(always)]
-    pub(super) fn energy_and_powers<O: ContactKinds>(
+    pub(super) fn energy_and_powers<K: Lanes, O: ContactKinds>(
         &self,
         modal: (f64, f64, f64),
     ) -> (f64, [f64; 5]) {
         let (mut e, modal_damping, mut external) = modal;
         // the external force holds the fluid-elastic one: its power apart
         let fluid = match &self.fluid {
-            Some(f) => crate::structure::modal::dot(&f.force, &self.cd.qd),
+            Some(f) => K::dot(&f.force, &self.cd.qd),
             None => 0.0,
         };
         external -= fluid;

@@ -14,7 +14,7 @@ use super::contact_kinds::ContactKinds;
 use super::{ContactState, Simulation, Tangential, contact_rows, contact_states};
 use crate::contact::frame_rows::FrameRows;
 use crate::kernels::Lanes;
-use crate::structure::modal::{recombine, recombine_with};
+use crate::structure::modal::recombine_with;
 
 impl Simulation<'_> {
     /// The external modal force at `t`: `Σ_l s_l(t) Φ_lᵀ F_l` over the loads' rows, plus the
@@ -91,7 +91,7 @@ impl Simulation<'_> {
                 }
                 None => {
                     let pt = &self.model.basis.points[c.point];
-                    state.x = pt.coords + recombine(&pt.rows, &self.cd.q);
+                    state.x = pt.coords + recombine_with::<K>(&pt.rows, &self.cd.q);
                     state.frame = c.frame(&state.x, t);
                 }
             }
@@ -139,7 +139,7 @@ impl Simulation<'_> {
                 // the anchor of the penalty law lives in the obstacle's frame
                 let (d, _) = c.motion.at(t);
                 let rows = contact_rows(self.model, &self.surface_rows, k);
-                state.x_relative = pt.coords + recombine(rows, &self.cd.q) - d;
+                state.x_relative = pt.coords + recombine_with::<K>(rows, &self.cd.q) - d;
             }
         }
         open_within

@@ -633,8 +633,8 @@ impl<'m> Simulation<'m> {
                 };
             }
         }
-        let (e, powers) =
-            self.energy_and_powers::<AnyContacts>(self.cd.energy_and_powers(&self.external));
+        let (e, powers) = self
+            .energy_and_powers::<Portable, AnyContacts>(self.cd.energy_and_powers(&self.external));
         self.energy = EnergyBalance::start(e, powers);
         self.statistics.start(
             self.contacts
@@ -774,7 +774,7 @@ impl<'m> Simulation<'m> {
             let first = self.contacts.iter().position(|c| !c.accumulable(bound));
             return Err(diverged(first));
         }
-        let (e, powers) = self.energy_and_powers::<O>(modal);
+        let (e, powers) = self.energy_and_powers::<K, O>(modal);
         let magnitude = e.abs() + powers.iter().map(|p| p.abs()).sum::<f64>();
         if magnitude > bound || magnitude.is_nan() {
             return Err(diverged(None));

@@ -9,7 +9,7 @@ use crate::contact::delassus::{Slot, TangentialProblem};
 use crate::contact::friction::Slide;
 use crate::contact::tangential::active_set::{ActiveSet, History};
 use crate::contact::tangential::penalty::PenaltyContact;
-use crate::contact::tangential::{LocalSolve, StickVelocity, gauss_seidel};
+use crate::contact::tangential::{StickVelocity, gauss_seidel};
 use crate::integrator::central_difference::CentralDifference;
 use crate::kernels::Lanes;
 use crate::model::Model;
@@ -178,10 +178,6 @@ impl Tangential {
     ) -> Self {
         let nc = model.contacts.len();
         let mut problem = TangentialProblem::new(model.basis.modes(), nc);
-        problem.set_exact_local_solve(match &solver {
-            LagrangeSolver::GaussSeidel(s) => s.local_solve == LocalSolve::Exact,
-            LagrangeSolver::ActiveSet(_) => true,
-        });
         for (k, c) in model.contacts.iter().enumerate() {
             if let Some(t) = c.fixed_tangents() {
                 let point = &model.basis.points[c.point];
