@@ -19,7 +19,7 @@ use std::cell::Cell;
 use nalgebra::{Matrix2, Vector2, Vector3};
 
 use crate::contact::friction::{DiagonalBlock, Slide};
-use crate::kernels::{Lanes, Portable};
+use crate::kernels::{Lanes, Portable, map3};
 use crate::structure::modal::thirds;
 
 /// One closed contact in the tangential problem.
@@ -154,9 +154,7 @@ impl TangentialProblem {
         for (a, t) in tangents.iter().enumerate() {
             let r = 2 * contact + a;
             let l = &mut self.l[r * p..(r + 1) * p];
-            for (((l, x), y), z) in l.iter_mut().zip(x).zip(y).zip(z) {
-                *l = t.x * x + t.y * y + t.z * z;
-            }
+            map3(l, x, y, z, |x, y, z| t.x * x + t.y * y + t.z * z);
             apply_a_inv(l, &mut self.al[r * p..(r + 1) * p]);
         }
     }

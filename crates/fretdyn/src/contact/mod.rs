@@ -30,6 +30,7 @@ use nalgebra::Vector3;
 
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::{ContactFrame, Obstacle};
+use crate::kernels::map3;
 use crate::structure::modal::{Point, thirds};
 
 /// Normal penalty law `R_N = max(0, K_N δ + C_N δ̇)` for `δ > 0`, `R_N = 0` otherwise (THEORY §3).
@@ -151,20 +152,14 @@ impl Contact {
     pub fn surface_rows(&self, point: &Point, n: &Vector3<f64>, out: &mut [f64]) {
         let p = out.len() / 3;
         let r = self.radius;
-        // slices of equal length: no bounds checks, and the loops vectorise
+        // slices of equal length, in blocks of four: no bounds checks, vector operations
         let [ux, uy, uz] = thirds(&point.rows, p);
         let [tx, ty, tz] = thirds(&point.rotations, p);
         let (ox, rest) = out[..3 * p].split_at_mut(p);
         let (oy, oz) = rest.split_at_mut(p);
-        for (((o, u), a), b) in ox.iter_mut().zip(ux).zip(tz).zip(ty) {
-            *o = u + r * (n.y * a - n.z * b);
-        }
-        for (((o, u), a), b) in oy.iter_mut().zip(uy).zip(tx).zip(tz) {
-            *o = u + r * (n.z * a - n.x * b);
-        }
-        for (((o, u), a), b) in oz.iter_mut().zip(uz).zip(ty).zip(tx) {
-            *o = u + r * (n.x * a - n.y * b);
-        }
+        map3(ox, ux, tz, ty, |u, a, b| u + r * (n.y * a - n.z * b));
+        map3(oy, uy, tx, tz, |u, a, b| u + r * (n.z * a - n.x * b));
+        map3(oz, uz, ty, tx, |u, a, b| u + r * (n.x * a - n.y * b));
     }
 
     /// The tangent basis when the contact's Delassus rows never change: a fixed tangent basis,
