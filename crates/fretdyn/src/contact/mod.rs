@@ -152,7 +152,7 @@ impl Contact {
     pub fn surface_rows(&self, point: &Point, n: &Vector3<f64>, out: &mut [f64]) {
         let p = out.len() / 3;
         let r = self.radius;
-        // slices of equal length, in blocks of four: no bounds checks, vector operations
+        // slices of equal length, indexed (`map3`): no bounds checks, vector operations
         let [ux, uy, uz] = thirds(&point.rows, p);
         let [tx, ty, tz] = thirds(&point.rotations, p);
         let (ox, rest) = out[..3 * p].split_at_mut(p);
