@@ -92,7 +92,7 @@ fn local_solve(c: &mut Criterion) {
     let mut group = c.benchmark_group("local_solve_1000_slips");
     group.throughput(Throughput::Elements(rhs.len() as u64));
     for mode in [LocalSolve::Radial, LocalSolve::Exact] {
-        let block = DiagonalBlock::new(h, mode == LocalSolve::Exact);
+        let block = DiagonalBlock::new(h);
         group.bench_function(format!("{mode:?}").to_lowercase(), |b| {
             b.iter(|| {
                 let mut previous = Vector2::zeros();

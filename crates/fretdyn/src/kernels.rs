@@ -100,10 +100,11 @@ pub(crate) fn running_min(m: f64, x: f64) -> f64 {
     }
 }
 
-/// `out_i = f(x_i, y_i, z_i)` over slices of `out`'s length, as an indexed loop over slices
-/// of equal length, which the compiler turns into vector operations where the same loop over
-/// four zipped slices stays scalar (elementwise: the same bits either way). The rows of a contact on the tube surface
-/// and its Delassus rows, formed at every step when the obstacle is not a fixed plane.
+/// `out_i = f(x_i, y_i, z_i)` over slices of `out`'s length: an indexed loop over slices of
+/// equal length, which the compiler turns into vector operations where the same loop over
+/// four zipped slices stays scalar (elementwise: the same bits either way). The rows of a
+/// contact on the tube surface and its Delassus rows, formed at every step when the
+/// obstacle is not a fixed plane.
 #[inline(always)]
 pub(crate) fn map3(
     out: &mut [f64],

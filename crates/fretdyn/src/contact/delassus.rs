@@ -138,7 +138,7 @@ impl TangentialProblem {
             self.h_fixed[(r + 1) * st + r],
             self.h_fixed[(r + 1) * st + r + 1],
         );
-        self.diagonal_fixed[contact] = DiagonalBlock::new(h, true);
+        self.diagonal_fixed[contact] = DiagonalBlock::new(h);
     }
 
     #[inline(always)]
@@ -302,7 +302,7 @@ impl TangentialProblem {
             self.newton[k].set(f64::NAN);
             if !fixed_k {
                 // a fixed contact's block was prepared once ([`Self::diagonal_block`])
-                self.diagonal[k] = DiagonalBlock::new(self.block(k, k), false);
+                self.diagonal[k] = DiagonalBlock::new(self.block(k, k));
             }
         }
     }

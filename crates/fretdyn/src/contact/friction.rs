@@ -80,14 +80,14 @@ pub struct DiagonalBlock {
 }
 
 impl DiagonalBlock {
-    /// The block `h` (symmetric positive semi-definite). `eager`: its eigen-decomposition is
-    /// formed now (a block that serves a whole run); otherwise at its first exact slip solve.
+    /// The block `h` (symmetric positive semi-definite); its eigen-decomposition is formed at
+    /// its first exact slip solve and kept (for the run, for a fixed plane's block).
     #[inline]
-    pub fn new(h: Matrix2<f64>, eager: bool) -> Self {
+    pub fn new(h: Matrix2<f64>) -> Self {
         Self {
             h,
             inverse: inverse2(&h),
-            eigen: Cell::new(eager.then(|| symmetric_eigen2(&h))),
+            eigen: Cell::new(None),
             isotropic: is_isotropic(&h),
             rho: {
                 let trace = h[(0, 0)] + h[(1, 1)];
@@ -125,7 +125,7 @@ impl DiagonalBlock {
 
 impl Default for DiagonalBlock {
     fn default() -> Self {
-        Self::new(Matrix2::zeros(), false)
+        Self::new(Matrix2::zeros())
     }
 }
 
@@ -143,7 +143,7 @@ pub fn local_solve(
     s_dynamic: f64,
     mode: LocalSolve,
 ) -> (Vector2<f64>, Slide) {
-    let block = DiagonalBlock::new(*h, mode == LocalSolve::Exact);
+    let block = DiagonalBlock::new(*h);
     local_solve_block(&block, c, s_static, s_dynamic, mode, &Cell::new(f64::NAN))
 }
 
@@ -473,13 +473,15 @@ mod tests {
         assert!(f(lam) <= best + 1e-9);
     }
 
-    /// A lazy block forms its eigen-decomposition at its first exact slip solve only (not for
-    /// a stick, nor for the radial projection), and its solves give the bits of an eager
-    /// block's.
+    /// A block forms its eigen-decomposition at its first exact slip solve only (not for a
+    /// stick, nor for the radial projection), keeps it, and its later solves give the bits of
+    /// a block given that decomposition from the start.
     #[test]
     fn eigen_decomposition_is_formed_at_the_first_exact_slip() {
         let h = Matrix2::new(2.0, 0.7, 0.7, 0.5);
-        let (lazy, eager) = (DiagonalBlock::new(h, false), DiagonalBlock::new(h, true));
+        let lazy = DiagonalBlock::new(h);
+        let eager = DiagonalBlock::new(h);
+        eager.eigen.set(Some(symmetric_eigen2(&h)));
         let start = || Cell::new(f64::NAN);
         let c = Vector2::new(3.0, -1.0);
         let (_, st) = local_solve_block(&lazy, &(c * 1e-3), 1.0, 0.5, LocalSolve::Exact, &start());
