@@ -7,6 +7,9 @@ use fretdyn::contact::tangential::StickVelocity;
 use fretdyn::integrator::simulation::simulate;
 
 use std::path::Path;
+use std::time::Instant;
+
+use fretdyn::integrator::simulation::Termination;
 
 use crate::Failure;
 use crate::out::outln;
@@ -129,6 +132,96 @@ pub fn scaling(dir: &Path, steps: u64) -> Result<(), Failure> {
     Ok(())
 }
 
+/// `fretdyn bench --pair A B`: the two cases run in this process alternately, the order
+/// swapped every round, `rounds` times (`steps` each instead of their own when given, only
+/// their first and last samples recorded). Reports each case's time-loop steps/s (median and
+/// best) and the median and quartiles of the per-round ratio B/A. On a shared machine whose
+/// speed drifts over seconds, separate processes of one build differ by ±10 % and more;
+/// rounds alternated in one process see the same drift and resolve a few per cent.
+pub fn pair(a: &Path, b: &Path, rounds: usize, steps: Option<u64>) -> Result<(), Failure> {
+    let load = |path: &Path| -> Result<Case, Failure> {
+        let mut case = Case::from_file(path).map_err(|e| Failure::input(e.in_file(path)))?;
+        if let Some(steps) = steps {
+            case.settings.steps = steps;
+        }
+        case.settings.output_every = case.settings.steps.max(1);
+        Ok(case)
+    };
+    let cases = [load(a)?, load(b)?];
+    let paths = [a, b];
+    let rounds = rounds.max(1);
+    outln!(
+        "machine: {}, {} logical CPUs; fretdyn {} (release build: {})",
+        cpu_model(),
+        std::thread::available_parallelism().map_or(1, |n| n.get()),
+        env!("CARGO_PKG_VERSION"),
+        !cfg!(debug_assertions)
+    )?;
+    outln!("{rounds} rounds in this process, alternated (A, B), (B, A), …; time-loop steps/s\n")?;
+    let started = Instant::now();
+    let mut speeds = [Vec::with_capacity(rounds), Vec::with_capacity(rounds)];
+    for round in 0..rounds {
+        let order = if round % 2 == 0 { [0, 1] } else { [1, 0] };
+        for k in order {
+            let r = simulate(&cases[k].model, &cases[k].settings)
+                .map_err(|e| Failure::failed(format!("{}: {e}", paths[k].display())))?;
+            if r.termination != Termination::Completed {
+                return Err(Failure::failed(format!(
+                    "{}: the run did not complete ({:?}): nothing to time",
+                    paths[k].display(),
+                    r.termination
+                )));
+            }
+            speeds[k].push(r.steps_per_second());
+        }
+    }
+    outln!("| case | file | method | steps | steps/s (median) | steps/s (best) |")?;
+    outln!("|---|---|---|---|---|---|")?;
+    for (k, label) in ["A", "B"].iter().enumerate() {
+        let [_, median, _] = quartiles(&speeds[k]);
+        let best = speeds[k].iter().copied().fold(0.0, f64::max);
+        outln!(
+            "| {label} | {} | {} | {} | {median:.4e} | {best:.4e} |",
+            paths[k].display(),
+            cases[k].settings.method.name(),
+            cases[k].settings.steps
+        )?;
+    }
+    let ratios: Vec<f64> = speeds[1]
+        .iter()
+        .zip(&speeds[0])
+        .map(|(b, a)| b / a)
+        .collect();
+    let [q1, median, q3] = quartiles(&ratios);
+    let best = |k: usize| speeds[k].iter().copied().fold(0.0, f64::max);
+    outln!(
+        "\nratio B/A of steps/s: median {median:.4} (quartiles {q1:.4}–{q3:.4}), best/best {:.4}; {:.0} s",
+        best(1) / best(0),
+        started.elapsed().as_secs_f64()
+    )?;
+    Ok(())
+}
+
+/// First quartile, median and third quartile (linear interpolation between the order
+/// statistics, as numpy's default); NaN for no values.
+fn quartiles(values: &[f64]) -> [f64; 3] {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let at = |q: f64| {
+        if v.is_empty() {
+            return f64::NAN;
+        }
+        let x = q * (v.len() - 1) as f64;
+        let (i, f) = (x.floor() as usize, x.fract());
+        if i + 1 < v.len() {
+            v[i] + f * (v[i + 1] - v[i])
+        } else {
+            v[i]
+        }
+    };
+    [at(0.25), at(0.5), at(0.75)]
+}
+
 fn bench_case(case: &Case, repeat: usize) -> Result<(), Failure> {
     let mut best = f64::INFINITY;
     let mut closed = 0;
@@ -167,4 +260,18 @@ pub(crate) fn cpu_model() -> String {
                 .map(|m| m.trim().to_string())
         })
         .unwrap_or_else(|| "unknown CPU".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::quartiles;
+
+    /// numpy's `percentile(v, [25, 50, 75])` of the same values.
+    #[test]
+    fn quartiles_interpolate_as_numpy() {
+        assert_eq!(quartiles(&[4.0, 1.0, 3.0, 2.0]), [1.75, 2.5, 3.25]);
+        assert_eq!(quartiles(&[5.0, 1.0, 3.0]), [2.0, 3.0, 4.0]);
+        assert_eq!(quartiles(&[7.0]), [7.0, 7.0, 7.0]);
+        assert!(quartiles(&[]).iter().all(|q| q.is_nan()));
+    }
 }

@@ -181,6 +181,16 @@ enum Command {
         /// they are absent).
         #[arg(long, value_name = "FILE", value_parser = path, requires = "against_c")]
         write: Option<PathBuf>,
+        /// Instead: time two case files against each other in this process, alternately
+        /// (the order swapped every round), and report the median and quartiles of the
+        /// per-round ratio of steps/s B/A — what resolves a few per cent on a shared machine
+        /// (e.g. one friction method against another; --steps overrides both cases' steps).
+        #[arg(long, num_args = 2, value_names = ["A", "B"], value_parser = path,
+              conflicts_with_all = ["against_c", "scaling"])]
+        pair: Option<Vec<PathBuf>>,
+        /// With --pair: rounds (each runs A and B once).
+        #[arg(long, default_value_t = 100, requires = "pair")]
+        rounds: usize,
     },
 }
 
@@ -309,16 +319,20 @@ fn main() -> ExitCode {
             reps,
             only,
             write,
-        } => match (scaling, against_c) {
-            (_, Some(dir)) => against_c::main(&against_c::Options {
+            pair,
+            rounds,
+        } => match (pair.as_deref(), scaling, against_c) {
+            // (clap takes exactly two values for --pair)
+            (Some([a, b]), _, _) => bench::pair(a, b, rounds, steps),
+            (_, _, Some(dir)) => against_c::main(&against_c::Options {
                 dir,
                 reps,
                 only,
                 steps,
                 write,
             }),
-            (Some(dir), None) => bench::scaling(&dir, steps.unwrap_or(20_000).min(20_000)),
-            (None, None) => bench::main(steps.unwrap_or(200_000), repeat, modes, contacts),
+            (_, Some(dir), None) => bench::scaling(&dir, steps.unwrap_or(20_000).min(20_000)),
+            (_, None, None) => bench::main(steps.unwrap_or(200_000), repeat, modes, contacts),
         },
     };
     match outcome {

@@ -1302,3 +1302,40 @@ fn completions_are_a_script_for_the_shell() {
         "{stderr}"
     );
 }
+
+/// `bench --pair A B`: both cases run with the steps asked, and the ratio is B's steps/s over
+/// A's — a case whose step costs ~20 times more (a U-bend in cross-flow, its turbulence and
+/// fluid-elastic forces) against a single-contact one, in both orders.
+#[test]
+fn bench_pair_reports_b_over_a() {
+    let ex = examples();
+    let ratio = |a: &str, b: &str| -> f64 {
+        let out = fretdyn(
+            &["bench", "--pair", a, b, "--rounds", "3", "--steps", "1000"],
+            &ex,
+        );
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for (label, file) in [("A", a), ("B", b)] {
+            let row = format!("| {label} | {file} | gauss_seidel | 1000 |");
+            assert!(text.contains(&row), "no row {row} in\n{text}");
+        }
+        let line = text
+            .lines()
+            .find(|l| l.starts_with("ratio B/A of steps/s: median "))
+            .unwrap_or_else(|| panic!("no ratio in\n{text}"));
+        line["ratio B/A of steps/s: median ".len()..]
+            .split_whitespace()
+            .next()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no number in {line}"))
+    };
+    let cheap = "v1a_modal_inline.toml";
+    let costly = "ubend_flow.toml";
+    assert!(ratio(cheap, costly) < 0.5);
+    assert!(ratio(costly, cheap) > 2.0);
+}
