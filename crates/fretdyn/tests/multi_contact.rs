@@ -517,6 +517,49 @@ fn residual_from_the_last_sweep_is_the_natural_map_residual() {
     }
 }
 
+/// The residual the Active Set reports is formed with the sliding contacts' right-hand sides
+/// of its last iteration: it must be the natural-map residual of the λ it returns, formed from
+/// `b − Hλ` directly, bit for bit — on 3-contact problems of mixed statuses (from a cold
+/// history; the iteration bound 1 leaves only the problems solved at once converged).
+#[test]
+fn active_set_residual_is_the_natural_map_residual() {
+    let mut slips = 0;
+    for seed in 0..3u64 {
+        for factors in [[3.0, 0.2, 0.05], [0.3, 0.2, 0.1], [3.0, 2.0, 1.5]] {
+            let hand = hand_problem(0x5eed_0100 + seed, 8, 3, &factors);
+            let problem = &hand.problem;
+            let m = problem.len();
+            for iterations in [1, ActiveSetSettings::default().max_iterations] {
+                let settings = ActiveSetSettings {
+                    max_iterations: iterations,
+                    ..ActiveSetSettings::default()
+                };
+                let mut solver = ActiveSet::new(settings, m);
+                let mut lambda = vec![Vector2::zeros(); m];
+                let mut slide = vec![Slide::Stick; m];
+                let mut stats = SolverStatistics::default();
+                let history = vec![History::default(); m];
+                let outcome = solver.solve(problem, &history, &mut lambda, &mut slide, &mut stats);
+                if !matches!(outcome, Outcome::Converged(_)) {
+                    continue;
+                }
+                slips += slide.iter().filter(|&&s| s == Slide::Slip).count();
+                let reported = solver.residual(problem, &lambda, &slide);
+                let direct = problem.natural_map_residual(&lambda, &slide);
+                assert_eq!(
+                    reported.to_bits(),
+                    direct.to_bits(),
+                    "seed {seed}, {factors:?}: {reported:e} vs {direct:e}"
+                );
+            }
+        }
+    }
+    assert!(
+        slips > 0,
+        "no sliding contact: the recorded right-hand sides untested"
+    );
+}
+
 #[test]
 fn one_step_problem_gauss_seidel_active_set_and_projected_gradient_agree() {
     // 3 contacts, 6 unknowns; p = 8 modes so that L has full row rank and H is SPD (with

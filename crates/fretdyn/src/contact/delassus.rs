@@ -442,6 +442,25 @@ impl TangentialProblem {
         })
     }
 
+    /// [`Self::natural_map_residual`] with contact `k`'s local right-hand side
+    /// `c_k = b_k − Σ_{l≠k} H_kl λ_l` given by `rhs(k)` where it is known (`Some`): a solver
+    /// that formed it from the final λ passes it rather than have it formed again; the same
+    /// operations, so the same bits.
+    pub fn natural_map_residual_given(
+        &self,
+        lambda: &[Vector2<f64>],
+        slide: &[Slide],
+        rhs: impl Fn(usize) -> Option<Vector2<f64>>,
+    ) -> f64 {
+        if self.slots.len() == 1 && !lambda.is_empty() {
+            return self.single_residual(lambda[0], self.rhs(0), slide[0]);
+        }
+        self.natural_map(lambda, slide, |k| match rhs(k) {
+            Some(c) => c - self.block(k, k) * lambda[k],
+            None => self.residual_velocity(k, lambda),
+        })
+    }
+
     /// The natural-map residual with the residual velocities `w(k) = (b − Hλ)_k`.
     #[inline]
     fn natural_map(

@@ -69,6 +69,8 @@ pub struct ActiveSet {
     patterns: Vec<u64>,
     work: Vec<f64>,
     index: Vec<usize>,
+    /// A sliding contact's local right-hand side at its last status test (for the residual).
+    rhs: Vec<Vector2<f64>>,
 }
 
 impl ActiveSet {
@@ -82,6 +84,7 @@ impl ActiveSet {
             patterns: Vec::with_capacity(settings.max_iterations + 1),
             work: vec![0.0; n * n + 2 * n],
             index: vec![0; n],
+            rhs: vec![Vector2::zeros(); contacts],
         }
     }
 
@@ -138,7 +141,7 @@ impl ActiveSet {
                     let bound = slot.s_static * (1.0 + 1e-12);
                     if lambda[k].norm_squared() > bound * bound {
                         self.stick[k] = false;
-                        let (local, _) = local_exact(problem, k, lambda);
+                        let (local, _) = local_exact(problem, k, problem.local_rhs(k, lambda));
                         let n = local.norm();
                         self.direction[k] = if n > 0.0 {
                             local / n
@@ -148,7 +151,9 @@ impl ActiveSet {
                         status_changed = true;
                     }
                 } else {
-                    let (local, local_slide) = local_exact(problem, k, lambda);
+                    let c = problem.local_rhs(k, lambda);
+                    self.rhs[k] = c;
+                    let (local, local_slide) = local_exact(problem, k, c);
                     if local_slide == Slide::Stick {
                         self.stick[k] = true;
                         status_changed = true;
@@ -225,20 +230,32 @@ impl ActiveSet {
         }
         outcome
     }
+
+    /// After a solve whose outcome was [`Outcome::Converged`]: the natural-map residual of the
+    /// λ it returned (THEORY §4.2), bit for bit
+    /// [`TangentialProblem::natural_map_residual`], with the sliding contacts' right-hand
+    /// sides taken from the last iteration's status tests — which changed no λ, so that they
+    /// were formed from the final λ — rather than formed again.
+    pub fn residual(
+        &self,
+        problem: &TangentialProblem,
+        lambda: &[Vector2<f64>],
+        slide: &[Slide],
+    ) -> f64 {
+        problem
+            .natural_map_residual_given(lambda, slide, |k| (!self.stick[k]).then_some(self.rhs[k]))
+    }
 }
 
-/// Contact `k`'s exact local problem, the others frozen at `lambda` (THEORY §4.4); in line
-/// (it runs for every contact at every status iteration).
+/// Contact `k`'s exact local problem with the right-hand side `c` (the others frozen:
+/// [`TangentialProblem::local_rhs`]; THEORY §4.4); in line (it runs for every contact at every
+/// status iteration).
 #[inline(always)]
-fn local_exact(
-    problem: &TangentialProblem,
-    k: usize,
-    lambda: &[Vector2<f64>],
-) -> (Vector2<f64>, Slide) {
+fn local_exact(problem: &TangentialProblem, k: usize, c: Vector2<f64>) -> (Vector2<f64>, Slide) {
     let slot = &problem.slots()[k];
     local_solve_block(
         problem.diagonal_block(k),
-        &problem.local_rhs(k, lambda),
+        &c,
         slot.s_static,
         slot.s_dynamic,
         LocalSolve::Exact,

@@ -7,7 +7,7 @@ use nalgebra::Vector2;
 use super::{RunSettings, Simulation, contact_rows};
 use crate::contact::delassus::{Slot, TangentialProblem};
 use crate::contact::friction::Slide;
-use crate::contact::tangential::active_set::{ActiveSet, History};
+use crate::contact::tangential::active_set::{ActiveSet, History, Outcome};
 use crate::contact::tangential::penalty::PenaltyContact;
 use crate::contact::tangential::{StickVelocity, gauss_seidel};
 use crate::integrator::central_difference::CentralDifference;
@@ -101,13 +101,16 @@ impl Simulation<'_> {
                 residual = sweeps.residual;
             }
             LagrangeSolver::ActiveSet(a) => {
-                a.solve(
+                let outcome = a.solve(
                     problem,
                     history,
                     &mut lambda[..m],
                     &mut slide[..m],
                     &mut self.solver_stats,
                 );
+                if matches!(outcome, Outcome::Converged(_)) {
+                    residual = Some(a.residual(problem, &lambda[..m], &slide[..m]));
+                }
             }
         }
         let residual =
