@@ -348,8 +348,10 @@ impl TangentialProblem {
         Vector2::new(self.b[2 * k], self.b[2 * k + 1])
     }
 
-    /// `b_k − Σ_{l≠k} H_kl λ_l`: the right-hand side of contact k's local problem.
-    #[inline]
+    /// `b_k − Σ_{l≠k} H_kl λ_l`: the right-hand side of contact k's local problem. In line
+    /// wherever it is called (the sweeps, the Active Set's status tests: a call costs these
+    /// short loops ~1 % of the Active Set's step).
+    #[inline(always)]
     pub fn local_rhs(&self, k: usize, lambda: &[Vector2<f64>]) -> Vector2<f64> {
         let m = self.slots.len().min(lambda.len());
         let row0 = &self.h[2 * k * self.stride..][..2 * m];
