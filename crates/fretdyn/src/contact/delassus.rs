@@ -384,11 +384,7 @@ impl TangentialProblem {
     /// of a sliding contact; it is 0 exactly when λ satisfies Coulomb's law. Returned as
     /// `‖r‖ / max(‖λ‖, max_i s_i)`, relative to the friction forces at stake.
     pub fn natural_map_residual(&self, lambda: &[Vector2<f64>], slide: &[Slide]) -> f64 {
-        if self.slots.len() == 1 && !lambda.is_empty() {
-            // a single contact (the common case), without the loops: the same operations
-            return self.single_residual(lambda[0], self.rhs(0), slide[0]);
-        }
-        self.natural_map(lambda, slide, |k| self.residual_velocity(k, lambda))
+        self.natural_map_residual_given(lambda, slide, |_| None)
     }
 
     /// [`Self::natural_map_residual`] of a single contact whose local right-hand side
@@ -455,6 +451,7 @@ impl TangentialProblem {
         rhs: impl Fn(usize) -> Option<Vector2<f64>>,
     ) -> f64 {
         if self.slots.len() == 1 && !lambda.is_empty() {
+            // a single contact (the common case), without the loops: the same operations
             return self.single_residual(lambda[0], self.rhs(0), slide[0]);
         }
         self.natural_map(lambda, slide, |k| match rhs(k) {
