@@ -3,7 +3,8 @@
 use fretdyn::apps::benchmark::{methods, rattling_tube};
 use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
-use fretdyn::contact::tangential::StickVelocity;
+use fretdyn::contact::friction::LocalSolve;
+use fretdyn::contact::tangential::{StickVelocity, TangentialMethod};
 use fretdyn::integrator::simulation::simulate;
 
 use std::path::Path;
@@ -183,7 +184,7 @@ pub fn pair(a: &Path, b: &Path, rounds: usize, steps: Option<u64>) -> Result<(),
         outln!(
             "| {label} | {} | {} | {} | {median:.4e} | {best:.4e} |",
             paths[k].display(),
-            cases[k].settings.method.name(),
+            method_label(&cases[k].settings.method),
             cases[k].settings.steps
         )?;
     }
@@ -200,6 +201,20 @@ pub fn pair(a: &Path, b: &Path, rounds: usize, steps: Option<u64>) -> Result<(),
         started.elapsed().as_secs_f64()
     )?;
     Ok(())
+}
+
+/// The method's name, with the local solve of Gauss–Seidel (`gauss_seidel (exact)`).
+fn method_label(method: &TangentialMethod) -> String {
+    match method {
+        TangentialMethod::GaussSeidel(s) => {
+            let local = match s.local_solve {
+                LocalSolve::Exact => "exact",
+                LocalSolve::Radial => "radial",
+            };
+            format!("{} ({local})", method.name())
+        }
+        _ => method.name().to_string(),
+    }
 }
 
 /// First quartile, median and third quartile (linear interpolation between the order

@@ -1321,7 +1321,7 @@ fn bench_pair_reports_b_over_a() {
             String::from_utf8_lossy(&out.stderr)
         );
         for (label, file) in [("A", a), ("B", b)] {
-            let row = format!("| {label} | {file} | gauss_seidel | 1000 |");
+            let row = format!("| {label} | {file} | gauss_seidel (exact) | 1000 |");
             assert!(text.contains(&row), "no row {row} in\n{text}");
         }
         let line = text
