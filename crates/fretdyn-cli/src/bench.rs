@@ -3,14 +3,11 @@
 use fretdyn::apps::benchmark::{methods, rattling_tube};
 use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
-use fretdyn::contact::friction::LocalSolve;
 use fretdyn::contact::tangential::{StickVelocity, TangentialMethod};
-use fretdyn::integrator::simulation::simulate;
+use fretdyn::integrator::simulation::{Termination, simulate};
 
 use std::path::Path;
 use std::time::Instant;
-
-use fretdyn::integrator::simulation::Termination;
 
 use crate::Failure;
 use crate::out::outln;
@@ -178,14 +175,15 @@ pub fn pair(a: &Path, b: &Path, rounds: usize, steps: Option<u64>) -> Result<(),
     }
     outln!("| case | file | method | steps | steps/s (median) | steps/s (best) |")?;
     outln!("|---|---|---|---|---|---|")?;
+    let best = |k: usize| speeds[k].iter().copied().fold(0.0, f64::max);
     for (k, label) in ["A", "B"].iter().enumerate() {
         let [_, median, _] = quartiles(&speeds[k]);
-        let best = speeds[k].iter().copied().fold(0.0, f64::max);
         outln!(
-            "| {label} | {} | {} | {} | {median:.4e} | {best:.4e} |",
+            "| {label} | {} | {} | {} | {median:.4e} | {:.4e} |",
             paths[k].display(),
             method_label(&cases[k].settings.method),
-            cases[k].settings.steps
+            cases[k].settings.steps,
+            best(k)
         )?;
     }
     let ratios: Vec<f64> = speeds[1]
@@ -194,7 +192,6 @@ pub fn pair(a: &Path, b: &Path, rounds: usize, steps: Option<u64>) -> Result<(),
         .map(|(b, a)| b / a)
         .collect();
     let [q1, median, q3] = quartiles(&ratios);
-    let best = |k: usize| speeds[k].iter().copied().fold(0.0, f64::max);
     outln!(
         "\nratio B/A of steps/s: median {median:.4} (quartiles {q1:.4}–{q3:.4}), best/best {:.4}; {:.0} s",
         best(1) / best(0),
@@ -207,11 +204,7 @@ pub fn pair(a: &Path, b: &Path, rounds: usize, steps: Option<u64>) -> Result<(),
 fn method_label(method: &TangentialMethod) -> String {
     match method {
         TangentialMethod::GaussSeidel(s) => {
-            let local = match s.local_solve {
-                LocalSolve::Exact => "exact",
-                LocalSolve::Radial => "radial",
-            };
-            format!("{} ({local})", method.name())
+            format!("{} ({})", method.name(), s.local_solve.name())
         }
         _ => method.name().to_string(),
     }

@@ -62,6 +62,16 @@ pub enum LocalSolve {
     Radial,
 }
 
+impl LocalSolve {
+    /// Its name in case files and summaries: `exact`, `radial`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LocalSolve::Exact => "exact",
+            LocalSolve::Radial => "radial",
+        }
+    }
+}
+
 /// A contact's 2 × 2 diagonal block `H_ii` of the Delassus operator with what its local solve
 /// needs of it: its inverse ([`inverse2`]) and its eigen-decomposition, formed once per step
 /// rather than at every sweep — the eigen-decomposition (two square roots, two divisions)

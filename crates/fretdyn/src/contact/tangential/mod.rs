@@ -72,10 +72,7 @@ impl Default for GaussSeidelSettings {
 }
 
 fn serialize_local_solve<S: serde::Serializer>(v: &LocalSolve, s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_str(match v {
-        LocalSolve::Exact => "exact",
-        LocalSolve::Radial => "radial",
-    })
+    s.serialize_str(v.name())
 }
 
 /// Active Set parameters (THEORY §4.3).
