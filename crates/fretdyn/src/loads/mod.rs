@@ -12,6 +12,7 @@
 pub mod flow;
 pub mod fluid_elastic;
 pub mod spatial_correlation;
+pub mod stepped;
 pub mod turbulence;
 
 use nalgebra::Vector3;

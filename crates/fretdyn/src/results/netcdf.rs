@@ -195,8 +195,10 @@ fn write_to(
         if row_len == 0 || s.rows == 0 {
             continue;
         }
-        // blocks of whole chunks, READ_BYTES at most
-        let block_rows = chunk_rows * (READ_BYTES / (chunk_rows * row_bytes)).max(1);
+        // blocks of whole chunks, READ_BYTES at most, and no more rows than the series has
+        // (the buffer is zeroed: a short run's 4 MiB per series was most of its write)
+        let block_rows =
+            (chunk_rows * (READ_BYTES / (chunk_rows * row_bytes)).max(1)).min(s.rows as usize);
         let mut f = File::open(s.path)?;
         f.seek(SeekFrom::Start(NPY_HEADER as u64))?;
         let mut bytes = vec![0u8; block_rows * row_bytes];
@@ -257,6 +259,11 @@ fn numeric<T: ::netcdf::NcTypeDescriptor>(
 /// A coordinate of names.
 fn strings(file: &mut ::netcdf::FileMut, d: &Variable, values: &[String]) -> std::io::Result<()> {
     let mut v = file.add_string_variable(d.name, d.dims).map_err(nc)?;
+    if d.dims.len() == 1 && !values.is_empty() {
+        // one chunk of the names: HDF5's default chunk for a string is allocated and
+        // zeroed at every `put_string` (megabytes each)
+        v.set_chunking(&[values.len()]).map_err(nc)?;
+    }
     describe(&mut v, d)?;
     for (i, s) in values.iter().enumerate() {
         v.put_string(s, [i]).map_err(nc)?;

@@ -17,23 +17,24 @@ use crate::kernels::Lanes;
 use crate::structure::modal::recombine_with;
 
 impl Simulation<'_> {
-    /// The external modal force at `t`: `Σ_l s_l(t) Φ_lᵀ F_l` over the loads' rows, plus the
-    /// turbulence (THEORY §7).
+    /// The external modal force of step `n`, at `t = n Δt`: `Σ_l s_l(t) Φ_lᵀ F_l` over the
+    /// loads' rows (the histories' sines rotated from step to step, THEORY §10), plus the
+    /// turbulence (THEORY §10).
     #[inline(always)]
-    pub(super) fn external_force<K: Lanes>(&mut self, t: f64) {
+    pub(super) fn external_force<K: Lanes>(&mut self, n: u64, t: f64) {
         let p = self.external.len();
         // the first load sets the force, the others add to it
-        match self.load_histories.split_first() {
+        match self.load_histories.split_first_mut() {
             Some((first, others)) => {
-                K::scale(&mut self.external, first.value(t), &self.load_rows[..p]);
+                K::scale(&mut self.external, first.value(n, t), &self.load_rows[..p]);
                 // (one load, the common case, skips the set-up of the loop: its rows' count
                 // is a division)
                 if !others.is_empty() {
                     for (history, row) in others
-                        .iter()
+                        .iter_mut()
                         .zip(self.load_rows[p..].chunks_exact(p.max(1)))
                     {
-                        K::axpy(&mut self.external, history.value(t), row);
+                        K::axpy(&mut self.external, history.value(n, t), row);
                     }
                 }
             }

@@ -43,6 +43,7 @@ use crate::integrator::central_difference::CentralDifference;
 use crate::integrator::stability::stable_time_step;
 use crate::kernels::{Lanes, Portable};
 use crate::loads::fluid_elastic::{DelayHistory, FluidElasticForce};
+use crate::loads::stepped::SteppedHistory;
 use crate::model::Model;
 use crate::results::energy::{EnergyBalance, EnergyRaw};
 use crate::results::recorder::Recorder;
@@ -198,7 +199,7 @@ pub struct Simulation<'m> {
     /// Modal loads `Φ_lᵀ F_l`, one row of p per load.
     load_rows: Vec<f64>,
     /// The time history of each row of `load_rows`, in order.
-    load_histories: Vec<&'m crate::loads::TimeHistory>,
+    load_histories: Vec<SteppedHistory<'m>>,
     /// Signal generators of the turbulent loads, one per load.
     turbulence: Vec<crate::loads::turbulence::RandomChannels>,
     /// Work space: the turbulence signals at the current time.
@@ -586,6 +587,7 @@ impl<'m> Simulation<'m> {
             load_histories: (model.loads.iter().map(|l| &l.history))
                 .chain(model.modal_loads.iter().map(|l| &l.history))
                 .chain(model.base_acceleration.iter().map(|b| &b.history))
+                .map(|h| SteppedHistory::new(h, settings.dt))
                 .collect(),
             turbulence,
             signals: vec![0.0; channels],
@@ -613,7 +615,7 @@ impl<'m> Simulation<'m> {
 
     /// t = 0: contacts at the initial state, initial acceleration, first sample.
     fn start(&mut self) {
-        self.external_force::<Portable>(0.0);
+        self.external_force::<Portable>(0, 0.0);
         self.fluid_elastic_force::<Portable>(0, false);
         let _ = self.detect::<Portable, AnyContacts>(0.0, false);
         self.contact_forces::<Portable, AnyContacts>();
@@ -745,7 +747,7 @@ impl<'m> Simulation<'m> {
         self.step += 1;
         let t = self.step as f64 * self.settings.dt;
         self.cd.predict_with::<K>();
-        self.external_force::<K>(t);
+        self.external_force::<K>(self.step, t);
         if self.fluid.is_some() {
             self.fluid_elastic_force::<K>(self.step, true);
         }
