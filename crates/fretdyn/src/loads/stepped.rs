@@ -13,8 +13,9 @@
 //! of a `sin` (about 90 instructions and the longest latency of a small step). The rotation
 //! adds a rounding error of a few `ε` per step; every [`ANCHOR_STEPS`] steps the pair is
 //! formed again from `sin` and `cos` of the angle computed as [`TimeHistory::value`] computes
-//! it, so the values differ from the direct ones by at most about `ANCHOR_STEPS · ε` (measured:
-//! the test below) and are exactly the direct ones at the anchors. The value at step `n` is a
+//! it: there the values are exactly the direct ones, and their error against the sine of the
+//! exact angle is at most the direct evaluation's own (the rounding of `ω t`, which grows with
+//! `t`) plus `4 ε · ANCHOR_STEPS` (the tests below). The value at step `n` is a
 //! function of `n` only: a run resumed from a checkpoint, or stepped one step at a time, gives
 //! the same bits as one run through (a step that does not follow the previous one starts from
 //! its anchor, `n − n mod ANCHOR_STEPS`).
