@@ -36,6 +36,20 @@ pub(crate) trait Lanes: Copy {
     /// Steps 1–2 of central differences: `q_i += Δt v_i + (h Δt) a_i`, `vs_i = v_i + h a_i`
     /// (slices of equal length; elementwise, so every width gives the same bits).
     fn predict(q: &mut [f64], vs: &mut [f64], v: &[f64], a: &[f64], dt: f64, h: f64);
+    /// [`Self::predict`] and, in the same pass, [`Self::scale`] `f_i = s g_i` (the first load's
+    /// modal force: one pass over the modes instead of two; slices of equal length).
+    #[allow(clippy::too_many_arguments)]
+    fn predict_and_scale(
+        q: &mut [f64],
+        vs: &mut [f64],
+        v: &[f64],
+        a: &[f64],
+        dt: f64,
+        h: f64,
+        f: &mut [f64],
+        s: f64,
+        g: &[f64],
+    );
     /// Step 5: `out_i = ai_i ((f_i − w2_i q_i) − c_i vs_i)` (slices of equal length).
     #[allow(clippy::too_many_arguments)]
     fn free_acceleration(
@@ -221,6 +235,28 @@ impl Lanes for Portable {
     }
 
     #[inline(always)]
+    fn predict_and_scale(
+        q: &mut [f64],
+        vs: &mut [f64],
+        v: &[f64],
+        a: &[f64],
+        dt: f64,
+        h: f64,
+        f: &mut [f64],
+        s: f64,
+        g: &[f64],
+    ) {
+        let p = q.len();
+        let (vs, v, a, f, g) = (&mut vs[..p], &v[..p], &a[..p], &mut f[..p], &g[..p]);
+        let hdt = h * dt;
+        for i in 0..p {
+            q[i] += dt * v[i] + hdt * a[i];
+            vs[i] = v[i] + h * a[i];
+            f[i] = s * g[i];
+        }
+    }
+
+    #[inline(always)]
     fn free_acceleration(
         out: &mut [f64],
         ai: &[f64],
@@ -338,7 +374,23 @@ impl<Tag> Lanes for Avx2<Tag> {
     #[inline(always)]
     fn predict(q: &mut [f64], vs: &mut [f64], v: &[f64], a: &[f64], dt: f64, h: f64) {
         // SAFETY: as above
-        unsafe { avx2::predict::<Tag>(q, vs, v, a, dt, h) }
+        unsafe { avx2::predict::<Tag, false>(q, vs, v, a, dt, h, &mut [], 0.0, &[]) }
+    }
+
+    #[inline(always)]
+    fn predict_and_scale(
+        q: &mut [f64],
+        vs: &mut [f64],
+        v: &[f64],
+        a: &[f64],
+        dt: f64,
+        h: f64,
+        f: &mut [f64],
+        s: f64,
+        g: &[f64],
+    ) {
+        // SAFETY: as above
+        unsafe { avx2::predict::<Tag, true>(q, vs, v, a, dt, h, f, s, g) }
     }
 
     #[inline(always)]
@@ -631,32 +683,40 @@ mod avx2 {
         unsafe { scaled::<true>(y, a, x) }
     }
 
-    /// [`super::Portable::predict`] on AVX2: four modes at a time, the last `p mod 4` by
-    /// plain loads and stores of the first lanes ([`tail`], [`store_first`]).
+    /// [`super::Portable::predict`] on AVX2 (with [`super::Portable::predict_and_scale`]'s
+    /// `f_i = s g_i` in the same pass when `LOAD`; `f` and `g` are not read otherwise): four
+    /// modes at a time, the last `p mod 4` by plain loads and stores of the first lanes
+    /// ([`tail`], [`store_first`]).
     ///
     /// # Safety
     /// The processor must have AVX2.
     #[inline]
     #[target_feature(enable = "avx2")]
     #[allow(clippy::extra_unused_type_parameters)] // `Tag`: a copy per caller ([`super::Avx2`])
-    pub(super) unsafe fn predict<Tag>(
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn predict<Tag, const LOAD: bool>(
         q: &mut [f64],
         vs: &mut [f64],
         v: &[f64],
         a: &[f64],
         dt: f64,
         h: f64,
+        f: &mut [f64],
+        s: f64,
+        g: &[f64],
     ) {
         let p = q.len();
         let (vs, v, a) = (&mut vs[..p], &v[..p], &a[..p]);
+        let (f, g) = if LOAD { (&mut f[..p], &g[..p]) } else { (f, g) };
         let full = p - p % 4;
         // SAFETY: AVX2 (the caller's guarantee); every load and store touches i..i + 4 ≤ full,
-        // the tail's ones full..p, within every slice
+        // the tail's ones full..p, within every slice (`f` and `g` of length p when `LOAD`)
         unsafe {
-            let (dtv, hh, hdt) = (
+            let (dtv, hh, hdt, sv) = (
                 _mm256_set1_pd(dt),
                 _mm256_set1_pd(h),
                 _mm256_set1_pd(h * dt),
+                _mm256_set1_pd(s),
             );
             let step = |qi: __m256d, vi: __m256d, ai: __m256d| {
                 (
@@ -676,6 +736,10 @@ mod avx2 {
                 );
                 _mm256_storeu_pd(q.as_mut_ptr().add(i), qn);
                 _mm256_storeu_pd(vs.as_mut_ptr().add(i), vn);
+                if LOAD {
+                    let gi = _mm256_loadu_pd(g.as_ptr().add(i));
+                    _mm256_storeu_pd(f.as_mut_ptr().add(i), _mm256_mul_pd(sv, gi));
+                }
                 i += 4;
             }
             if p > full {
@@ -687,6 +751,10 @@ mod avx2 {
                 );
                 store_first(q.as_mut_ptr().add(full), m, qn);
                 store_first(vs.as_mut_ptr().add(full), m, vn);
+                if LOAD {
+                    let gi = tail(g.as_ptr().add(full), m);
+                    store_first(f.as_mut_ptr().add(full), m, _mm256_mul_pd(sv, gi));
+                }
             }
         }
     }
@@ -916,12 +984,34 @@ mod tests {
                 (q.clone(), q.clone(), vec![0.0; n], vec![0.0; n]);
             Avx2::<()>::predict(&mut q1, &mut s1, &vs, &acc, 0.37, 0.185);
             Portable::predict(&mut q2, &mut s2, &vs, &acc, 0.37, 0.185);
+            // with the load in the same pass: the same state, and the load as `scale` forms it
+            let (mut q3, mut q4, mut s3, mut s4) =
+                (q.clone(), q.clone(), vec![0.0; n], vec![0.0; n]);
+            let (mut f1, mut f2, mut f3) = (vec![f64::NAN; n], vec![f64::NAN; n], vec![0.0; n]);
+            let load = -0.73;
+            Avx2::<()>::predict_and_scale(
+                &mut q3, &mut s3, &vs, &acc, 0.37, 0.185, &mut f1, load, &b,
+            );
+            Portable::predict_and_scale(
+                &mut q4, &mut s4, &vs, &acc, 0.37, 0.185, &mut f2, load, &b,
+            );
+            Portable::scale(&mut f3, load, &b);
             let (mut a1, mut a2) = (vec![0.0; n], vec![0.0; n]);
             Avx2::<()>::free_acceleration(&mut a1, &w2, &f, &damping, &q, &b, &c);
             Portable::free_acceleration(&mut a2, &w2, &f, &damping, &q, &b, &c);
             let all = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(all(&q1), all(&q2), "{n}");
             assert_eq!(all(&s1), all(&s2), "{n}");
+            for (x, y) in [
+                (&q3, &q1),
+                (&q4, &q1),
+                (&s3, &s1),
+                (&s4, &s1),
+                (&f1, &f3),
+                (&f2, &f3),
+            ] {
+                assert_eq!(all(x), all(y), "{n}");
+            }
             assert_eq!(all(&a1), all(&a2), "{n}");
             let (mut v1, mut v2) = (vec![0.0; n], vec![0.0; n]);
             let e1 =

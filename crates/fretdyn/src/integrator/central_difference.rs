@@ -149,6 +149,23 @@ impl CentralDifference {
         );
     }
 
+    /// [`Self::predict_with`] and, in the same pass, `f = s g` (the first load's modal force).
+    #[inline(always)]
+    pub(crate) fn predict_and_scale_with<K: Lanes>(&mut self, f: &mut [f64], s: f64, g: &[f64]) {
+        let dt = self.dt;
+        K::predict_and_scale(
+            &mut self.q,
+            &mut self.qd_star,
+            &self.qd,
+            &self.qdd,
+            dt,
+            0.5 * dt,
+            f,
+            s,
+            g,
+        );
+    }
+
     /// Step 5: `q̈_free = A⁻¹ (f − K q − C q̇*)`, written to `self.qdd`.
     #[inline(always)]
     pub fn free_acceleration(&mut self, force: &[f64]) {

@@ -19,26 +19,51 @@ use crate::structure::modal::recombine_with;
 impl Simulation<'_> {
     /// The external modal force of step `n`, at `t = n Δt`: `Σ_l s_l(t) Φ_lᵀ F_l` over the
     /// loads' rows (the histories' sines rotated from step to step, THEORY §10), plus the
-    /// turbulence (THEORY §10).
+    /// turbulence (THEORY §10). The step forms the first load's with the predictor instead
+    /// ([`Self::predict_with_first_load`]).
     #[inline(always)]
     pub(super) fn external_force<K: Lanes>(&mut self, n: u64, t: f64) {
         let p = self.external.len();
         // the first load sets the force, the others add to it
-        match self.load_histories.split_first_mut() {
-            Some((first, others)) => {
-                K::scale(&mut self.external, first.value(n, t), &self.load_rows[..p]);
-                // (one load, the common case, skips the set-up of the loop: its rows' count
-                // is a division)
-                if !others.is_empty() {
-                    for (history, row) in others
-                        .iter_mut()
-                        .zip(self.load_rows[p..].chunks_exact(p.max(1)))
-                    {
-                        K::axpy(&mut self.external, history.value(n, t), row);
-                    }
-                }
-            }
+        match self.load_histories.first_mut() {
+            Some(first) => K::scale(&mut self.external, first.value(n, t), &self.load_rows[..p]),
             None => self.external.fill(0.0),
+        }
+        self.other_loads::<K>(n, t);
+    }
+
+    /// Steps 1–2 (the predictor) of step `n` and, in the same pass over the modes, the first
+    /// load's force: the start of [`Self::external_force`] (the same bits), which
+    /// [`Self::other_loads`] completes.
+    #[inline(always)]
+    pub(super) fn predict_with_first_load<K: Lanes>(&mut self, n: u64, t: f64) {
+        let p = self.external.len();
+        match self.load_histories.first_mut() {
+            Some(first) => {
+                let s = first.value(n, t);
+                self.cd
+                    .predict_and_scale_with::<K>(&mut self.external, s, &self.load_rows[..p]);
+            }
+            None => {
+                self.cd.predict_with::<K>();
+                self.external.fill(0.0);
+            }
+        }
+    }
+
+    /// The loads after the first and the turbulence, added to the external force.
+    #[inline(always)]
+    pub(super) fn other_loads<K: Lanes>(&mut self, n: u64, t: f64) {
+        let p = self.external.len();
+        // (one load, the common case, skips the set-up of the loop: its rows' count is a
+        // division)
+        if self.load_histories.len() > 1 {
+            for (history, row) in self.load_histories[1..]
+                .iter_mut()
+                .zip(self.load_rows[p..].chunks_exact(p.max(1)))
+            {
+                K::axpy(&mut self.external, history.value(n, t), row);
+            }
         }
         if self.turbulence.is_empty() {
             return;

@@ -746,8 +746,8 @@ impl<'m> Simulation<'m> {
     fn try_step<K: Lanes, O: ContactKinds>(&mut self) -> std::result::Result<(), Divergence> {
         self.step += 1;
         let t = self.step as f64 * self.settings.dt;
-        self.cd.predict_with::<K>();
-        self.external_force::<K>(self.step, t);
+        self.predict_with_first_load::<K>(self.step, t);
+        self.other_loads::<K>(self.step, t);
         if self.fluid.is_some() {
             self.fluid_elastic_force::<K>(self.step, true);
         }
