@@ -225,13 +225,7 @@ impl Lanes for Portable {
 
     #[inline(always)]
     fn predict(q: &mut [f64], vs: &mut [f64], v: &[f64], a: &[f64], dt: f64, h: f64) {
-        let p = q.len();
-        let (vs, v, a) = (&mut vs[..p], &v[..p], &a[..p]);
-        let hdt = h * dt;
-        for i in 0..p {
-            q[i] += dt * v[i] + hdt * a[i];
-            vs[i] = v[i] + h * a[i];
-        }
+        portable_predict::<false>(q, vs, v, a, dt, h, &mut [], 0.0, &[]);
     }
 
     #[inline(always)]
@@ -246,14 +240,7 @@ impl Lanes for Portable {
         s: f64,
         g: &[f64],
     ) {
-        let p = q.len();
-        let (vs, v, a, f, g) = (&mut vs[..p], &v[..p], &a[..p], &mut f[..p], &g[..p]);
-        let hdt = h * dt;
-        for i in 0..p {
-            q[i] += dt * v[i] + hdt * a[i];
-            vs[i] = v[i] + h * a[i];
-            f[i] = s * g[i];
-        }
+        portable_predict::<true>(q, vs, v, a, dt, h, f, s, g);
     }
 
     #[inline(always)]
@@ -333,6 +320,35 @@ pub(crate) struct Avx2<Tag = ()>(std::marker::PhantomData<Tag>);
 impl<Tag> Clone for Avx2<Tag> {
     fn clone(&self) -> Self {
         *self
+    }
+}
+
+/// [`Portable::predict`], with [`Portable::predict_and_scale`]'s `f_i = s g_i` in the same
+/// loop when `LOAD` (`f` and `g` are not read otherwise): one loop for both, as
+/// `avx2::predict` is one for its two.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn portable_predict<const LOAD: bool>(
+    q: &mut [f64],
+    vs: &mut [f64],
+    v: &[f64],
+    a: &[f64],
+    dt: f64,
+    h: f64,
+    f: &mut [f64],
+    s: f64,
+    g: &[f64],
+) {
+    let p = q.len();
+    let (vs, v, a) = (&mut vs[..p], &v[..p], &a[..p]);
+    let (f, g) = if LOAD { (&mut f[..p], &g[..p]) } else { (f, g) };
+    let hdt = h * dt;
+    for i in 0..p {
+        q[i] += dt * v[i] + hdt * a[i];
+        vs[i] = v[i] + h * a[i];
+        if LOAD {
+            f[i] = s * g[i];
+        }
     }
 }
 
