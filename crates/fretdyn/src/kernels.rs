@@ -655,6 +655,17 @@ mod avx2 {
                 if SET { ax } else { _mm256_add_pd(y, ax) }
             };
             let (py, px) = (y.as_mut_ptr(), x.as_ptr());
+            // the last four values when n mod 4 ≠ 0 (and n ≥ 4): computed before the loop, from
+            // the `y` it has not yet overwritten, and stored after it (elementwise: the values
+            // shared with the last whole chunk are written twice, the same)
+            let last = (n > full && n >= 4).then(|| {
+                let y = if SET {
+                    _mm256_setzero_pd()
+                } else {
+                    _mm256_loadu_pd(py.add(n - 4))
+                };
+                value(y, _mm256_loadu_pd(px.add(n - 4)))
+            });
             let mut i = 0;
             while i < full {
                 let y = if SET {
@@ -665,7 +676,9 @@ mod avx2 {
                 _mm256_storeu_pd(py.add(i), value(y, _mm256_loadu_pd(px.add(i))));
                 i += 4;
             }
-            if n > full {
+            if let Some(x) = last {
+                _mm256_storeu_pd(py.add(n - 4), x);
+            } else if n > full {
                 let m = n - full;
                 let y = if SET {
                     _mm256_setzero_pd()
@@ -743,6 +756,23 @@ mod avx2 {
                     _mm256_add_pd(vi, _mm256_mul_pd(hh, ai)),
                 )
             };
+            // the last four modes when p mod 4 ≠ 0 (and p ≥ 4): computed before the loop, from
+            // the values it has not yet overwritten, and stored after it (elementwise: the
+            // modes it shares with the last whole chunk get the same values twice)
+            let last = (p > full && p >= 4).then(|| {
+                let j = p - 4;
+                let (qn, vn) = step(
+                    _mm256_loadu_pd(q.as_ptr().add(j)),
+                    _mm256_loadu_pd(v.as_ptr().add(j)),
+                    _mm256_loadu_pd(a.as_ptr().add(j)),
+                );
+                let fnew = if LOAD {
+                    _mm256_mul_pd(sv, _mm256_loadu_pd(g.as_ptr().add(j)))
+                } else {
+                    _mm256_setzero_pd()
+                };
+                (qn, vn, fnew)
+            });
             let mut i = 0;
             while i < full {
                 let (qn, vn) = step(
@@ -758,7 +788,14 @@ mod avx2 {
                 }
                 i += 4;
             }
-            if p > full {
+            if let Some((qn, vn, fnew)) = last {
+                let j = p - 4;
+                _mm256_storeu_pd(q.as_mut_ptr().add(j), qn);
+                _mm256_storeu_pd(vs.as_mut_ptr().add(j), vn);
+                if LOAD {
+                    _mm256_storeu_pd(f.as_mut_ptr().add(j), fnew);
+                }
+            } else if p > full {
                 let m = p - full;
                 let (qn, vn) = step(
                     tail(q.as_ptr().add(full), m),
@@ -817,7 +854,21 @@ mod avx2 {
                 _mm256_storeu_pd(out.as_mut_ptr().add(i), x);
                 i += 4;
             }
-            if p > full {
+            if p > full && p >= 4 {
+                // the last four modes again, as the loop forms them (`out` is apart from the
+                // inputs: the modes they share with the last whole chunk get the same values
+                // twice)
+                let j = p - 4;
+                let x = value(
+                    _mm256_loadu_pd(ai.as_ptr().add(j)),
+                    _mm256_loadu_pd(f.as_ptr().add(j)),
+                    _mm256_loadu_pd(w2.as_ptr().add(j)),
+                    _mm256_loadu_pd(q.as_ptr().add(j)),
+                    _mm256_loadu_pd(c.as_ptr().add(j)),
+                    _mm256_loadu_pd(vs.as_ptr().add(j)),
+                );
+                _mm256_storeu_pd(out.as_mut_ptr().add(j), x);
+            } else if p > full {
                 let m = p - full;
                 let x = value(
                     tail(ai.as_ptr().add(full), m),

@@ -669,6 +669,26 @@ mod tests {
         }
     }
 
+    /// `(αs H + αt I) u = αc` has the root `αt` and the same `u`: the slip solution of
+    /// `(αH, αc, s)` is that of `(H, c, s)`, also at scales where the Newton step's products
+    /// `N = c₀²e₁² + c₁²e₀²`, `M = c₀²e₁³ + c₁²e₀³` overflow or vanish (from `α ≈ 1e60` and
+    /// `α ≈ 1e-70`: the step is then taken in the form with `u`).
+    #[test]
+    fn exact_local_solve_is_scale_invariant() {
+        let h = Matrix2::new(2.0, 0.7, 0.7, 0.5);
+        let c = Vector2::new(3.0, -1.0);
+        let s = 0.4;
+        let (reference, _) = local_solve(&h, &c, s, s, LocalSolve::Exact);
+        for alpha in [1e-150, 1e-70, 1e40, 1e60, 1e70, 1e75, 1e100, 1e150] {
+            let (lam, st) = local_solve(&(h * alpha), &(c * alpha), s, s, LocalSolve::Exact);
+            assert_eq!(st, Slide::Slip, "α = {alpha}");
+            assert!(
+                (lam - reference).norm() <= 1e-12 * s,
+                "α = {alpha}: {lam} vs {reference}"
+            );
+        }
+    }
+
     /// Random blocks (anisotropy up to 10⁶, any orientation) and right-hand sides: the exact
     /// slip solution against the root of `|(sH + tI)⁻¹c| = 1` found by bisection in the
     /// original basis (no eigen-decomposition, no Newton).
