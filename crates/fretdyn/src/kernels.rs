@@ -636,8 +636,9 @@ mod avx2 {
     }
 
     /// [`super::Portable::axpy`] on AVX2 when `SET` is false, [`super::Portable::scale`]
-    /// when it is true: four values at a time, the last `n mod 4` by [`tail`] and
-    /// [`store_first`].
+    /// when it is true: four values at a time; the last `n mod 4` as part of the last four
+    /// values `n − 4..n` when `n ≥ 4` (formed before the loop, stored after it), else by
+    /// [`tail`] and [`store_first`].
     ///
     /// # Safety
     /// The processor must have AVX2.
@@ -647,7 +648,7 @@ mod avx2 {
         let n = y.len().min(x.len());
         let full = n - n % 4;
         // SAFETY: AVX2 (the caller's guarantee); every load and store touches i..i + 4 ≤ full,
-        // the tail's ones full..n, within both slices
+        // the last chunk's n − 4..n with n ≥ 4, the tail's ones full..n, within both slices
         unsafe {
             let av = _mm256_set1_pd(a);
             let value = |y: __m256d, x: __m256d| {
@@ -714,8 +715,10 @@ mod avx2 {
 
     /// [`super::Portable::predict`] on AVX2 (with [`super::Portable::predict_and_scale`]'s
     /// `f_i = s g_i` in the same pass when `LOAD`; `f` and `g` are not read otherwise): four
-    /// modes at a time, the last `p mod 4` by plain loads and stores of the first lanes
-    /// ([`tail`], [`store_first`]).
+    /// modes at a time; the last `p mod 4` as part of the last four modes `p − 4..p` when
+    /// `p ≥ 4` (formed before the loop overwrites any of them, stored after it: elementwise,
+    /// the same bits), else by plain loads and stores of the first lanes ([`tail`],
+    /// [`store_first`]).
     ///
     /// # Safety
     /// The processor must have AVX2.
@@ -739,7 +742,8 @@ mod avx2 {
         let (f, g) = if LOAD { (&mut f[..p], &g[..p]) } else { (f, g) };
         let full = p - p % 4;
         // SAFETY: AVX2 (the caller's guarantee); every load and store touches i..i + 4 ≤ full,
-        // the tail's ones full..p, within every slice (`f` and `g` of length p when `LOAD`)
+        // the last chunk's p − 4..p with p ≥ 4, the tail's ones full..p, within every slice
+        // (`f` and `g` of length p when `LOAD`)
         unsafe {
             let (dtv, hh, hdt, sv) = (
                 _mm256_set1_pd(dt),
@@ -812,8 +816,9 @@ mod avx2 {
         }
     }
 
-    /// [`super::Portable::free_acceleration`] on AVX2: four modes at a time, the last
-    /// `p mod 4` by [`tail`] and [`store_first`].
+    /// [`super::Portable::free_acceleration`] on AVX2: four modes at a time; the last
+    /// `p mod 4` as part of the last four modes `p − 4..p` again when `p ≥ 4`, else by
+    /// [`tail`] and [`store_first`].
     ///
     /// # Safety
     /// The processor must have AVX2.
