@@ -28,6 +28,12 @@ pub(crate) trait Lanes: Copy {
     /// row, `out.len()` rows), each summed exactly as [`Self::dot`] sums it: one pass over `x`
     /// serves four rows.
     fn dots(a: &[f64], x: &[f64], out: &mut [f64]);
+    /// [`Self::dots`] on rows laid out by [`PaddedRows`] (`x` of the rows' length `p`; all 0
+    /// when it is shorter): `out[r] = A_r·x` for the first `out.len()` rows, each summed
+    /// exactly as [`Self::dot`] sums it. The zeros after each row let the AVX2 code read
+    /// `x`'s last `p mod 4` values once for all rows, and it adds the lanes of four rows at
+    /// a time in one pass.
+    fn padded_dots(a: &PaddedRows, x: &[f64], out: &mut [f64]);
     /// `y_i += a x_i` (slices of equal length; elementwise, so every width gives the same
     /// bits): the contact forces added to the modal force, the loads, `q̈ −= A⁻¹Lᵀλ`.
     fn axpy(y: &mut [f64], a: f64, x: &[f64]);
@@ -135,6 +141,47 @@ pub(crate) fn map3(
     }
 }
 
+/// Rows of `p` values laid out for [`Lanes::padded_dots`]: each row followed by zeros up to
+/// `stride`, `p` rounded up to a multiple of four.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct PaddedRows {
+    values: Vec<f64>,
+    rows: usize,
+    p: usize,
+    stride: usize,
+}
+
+impl PaddedRows {
+    /// The rows `rows` of `p` values each (a row of another length is cut or completed by
+    /// zeros: the caller's rows have `p`).
+    pub(crate) fn new<'a>(p: usize, rows: impl ExactSizeIterator<Item = &'a [f64]>) -> Self {
+        let stride = p.next_multiple_of(4);
+        let n = rows.len();
+        let mut values = vec![0.0; stride * n];
+        for (out, row) in values.chunks_exact_mut(stride.max(1)).zip(rows) {
+            for (o, v) in out[..p].iter_mut().zip(row) {
+                *o = *v;
+            }
+        }
+        Self {
+            values,
+            rows: n,
+            p,
+            stride,
+        }
+    }
+
+    /// The number of rows: the length of [`Lanes::padded_dots`]'s output.
+    pub(crate) fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Row `r` (its `p` values).
+    fn row(&self, r: usize) -> &[f64] {
+        &self.values[r * self.stride..r * self.stride + self.p]
+    }
+}
+
 /// Plain Rust, for every processor.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Portable;
@@ -206,6 +253,17 @@ impl Lanes for Portable {
         }
         for (o, row) in out.iter_mut().zip(a.chunks_exact(p)) {
             *o = Self::dot(row, x);
+        }
+    }
+
+    #[inline(always)]
+    fn padded_dots(a: &PaddedRows, x: &[f64], out: &mut [f64]) {
+        if a.p == 0 || x.len() < a.p {
+            out.fill(0.0);
+            return;
+        }
+        for (r, o) in out.iter_mut().enumerate().take(a.rows) {
+            *o = Self::dot(a.row(r), x);
         }
     }
 
@@ -376,6 +434,12 @@ impl<Tag> Lanes for Avx2<Tag> {
     }
 
     #[inline(always)]
+    fn padded_dots(a: &PaddedRows, x: &[f64], out: &mut [f64]) {
+        // SAFETY: as above
+        unsafe { avx2::padded_dots(a, x, out) }
+    }
+
+    #[inline(always)]
     fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
         // SAFETY: as above
         unsafe { avx2::axpy(y, a, x) }
@@ -447,8 +511,9 @@ mod avx2 {
     use std::arch::x86_64::{
         __m256d, _mm_add_sd, _mm_cvtsd_f64, _mm_hadd_pd, _mm_load_sd, _mm_loadu_pd, _mm_store_sd,
         _mm_storeu_pd, _mm_unpackhi_pd, _mm256_add_pd, _mm256_castpd256_pd128,
-        _mm256_extractf128_pd, _mm256_insertf128_pd, _mm256_loadu_pd, _mm256_mul_pd,
-        _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd, _mm256_sub_pd, _mm256_zextpd128_pd256,
+        _mm256_extractf128_pd, _mm256_hadd_pd, _mm256_insertf128_pd, _mm256_loadu_pd,
+        _mm256_mul_pd, _mm256_permute2f128_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+        _mm256_sub_pd, _mm256_zextpd128_pd256,
     };
 
     /// The `r < 4` values at `p` in the first lanes, the others `+0`: one 64-bit load, one
@@ -579,6 +644,31 @@ mod avx2 {
         }
     }
 
+    /// The four-lane sums of the rows at `rows` times `x` over the whole chunks `0..full`
+    /// (`full` a multiple of four): the loop that [`dots`] and [`padded_dots`] share, one
+    /// load of `x` for the four rows.
+    ///
+    /// # Safety
+    /// The processor must have AVX2, and `rows[j]..rows[j] + full` and `x..x + full` must be
+    /// inside slices.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn four_rows(rows: [*const f64; 4], x: *const f64, full: usize) -> [__m256d; 4] {
+        let mut s = [_mm256_setzero_pd(); 4];
+        let mut i = 0;
+        // SAFETY: AVX2 and the loads' ranges are the caller's guarantees
+        unsafe {
+            while i < full {
+                let y = _mm256_loadu_pd(x.add(i));
+                for (sum, row) in s.iter_mut().zip(rows) {
+                    *sum = _mm256_add_pd(*sum, _mm256_mul_pd(_mm256_loadu_pd(row.add(i)), y));
+                }
+                i += 4;
+            }
+        }
+        s
+    }
+
     /// [`super::Portable::dots`] on AVX2: four rows at a time share each load of `x`; every
     /// row is summed as [`dot`] sums it.
     ///
@@ -600,21 +690,11 @@ mod avx2 {
         unsafe {
             while r + 4 <= rows {
                 let base = a.as_ptr().add(r * p);
-                let (mut s0, mut s1, mut s2, mut s3) = (
-                    _mm256_setzero_pd(),
-                    _mm256_setzero_pd(),
-                    _mm256_setzero_pd(),
-                    _mm256_setzero_pd(),
+                let [mut s0, mut s1, mut s2, mut s3] = four_rows(
+                    [base, base.add(p), base.add(2 * p), base.add(3 * p)],
+                    x.as_ptr(),
+                    full,
                 );
-                let mut i = 0;
-                while i < full {
-                    let y = _mm256_loadu_pd(x.as_ptr().add(i));
-                    s0 = _mm256_add_pd(s0, _mm256_mul_pd(_mm256_loadu_pd(base.add(i)), y));
-                    s1 = _mm256_add_pd(s1, _mm256_mul_pd(_mm256_loadu_pd(base.add(p + i)), y));
-                    s2 = _mm256_add_pd(s2, _mm256_mul_pd(_mm256_loadu_pd(base.add(2 * p + i)), y));
-                    s3 = _mm256_add_pd(s3, _mm256_mul_pd(_mm256_loadu_pd(base.add(3 * p + i)), y));
-                    i += 4;
-                }
                 if p > full {
                     let m = p - full;
                     let y = tail(x.as_ptr().add(full), m);
@@ -630,6 +710,84 @@ mod avx2 {
             }
             while r < rows {
                 out[r] = dot(&a[r * p..(r + 1) * p], x);
+                r += 1;
+            }
+        }
+    }
+
+    /// [`super::Portable::padded_dots`] on AVX2: four rows at a time share each load of `x`,
+    /// `x`'s last `p mod 4` values are read once ([`tail`]) and multiply each row's last chunk
+    /// (whose lanes past `p` are zeros, as [`dot`]'s tail loads them), and the four rows'
+    /// lanes are added in one pass: `(s₀ + s₁) + (s₂ + s₃)` of each row, as [`sum`] adds them;
+    /// the rows left over one at a time.
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn padded_dots(a: &super::PaddedRows, x: &[f64], out: &mut [f64]) {
+        let (p, stride) = (a.p, a.stride);
+        let rows = out.len().min(a.rows);
+        if p == 0 || x.len() < p {
+            out.fill(0.0);
+            return;
+        }
+        let full = p - p % 4;
+        // SAFETY: AVX2 (the caller's guarantee); row `r < rows ≤ a.rows` spans
+        // `a.values[r stride..(r + 1) stride]`, inside `a.values`; each row's loads read
+        // `i..i + 4 ≤ stride` of its values, `x`'s `i..i + 4 ≤ full ≤ p` and its tail
+        // `full..p`; the stores write `out[r..r + 4]` with `r + 4 ≤ rows`, or `out[r]`
+        unsafe {
+            let xt = if p > full {
+                tail(x.as_ptr().add(full), p - full)
+            } else {
+                _mm256_setzero_pd()
+            };
+            let (px, po) = (x.as_ptr(), out.as_mut_ptr());
+            let mut base = a.values.as_ptr();
+            let mut r = 0;
+            while r + 4 <= rows {
+                let (b0, b1, b2, b3) = (
+                    base,
+                    base.add(stride),
+                    base.add(2 * stride),
+                    base.add(3 * stride),
+                );
+                let [mut s0, mut s1, mut s2, mut s3] = four_rows([b0, b1, b2, b3], px, full);
+                if p > full {
+                    s0 = _mm256_add_pd(s0, _mm256_mul_pd(_mm256_loadu_pd(b0.add(full)), xt));
+                    s1 = _mm256_add_pd(s1, _mm256_mul_pd(_mm256_loadu_pd(b1.add(full)), xt));
+                    s2 = _mm256_add_pd(s2, _mm256_mul_pd(_mm256_loadu_pd(b2.add(full)), xt));
+                    s3 = _mm256_add_pd(s3, _mm256_mul_pd(_mm256_loadu_pd(b3.add(full)), xt));
+                }
+                // (s0₀ + s0₁, s1₀ + s1₁, s0₂ + s0₃, s1₂ + s1₃) and the same of s2, s3
+                let h01 = _mm256_hadd_pd(s0, s1);
+                let h23 = _mm256_hadd_pd(s2, s3);
+                let low = _mm256_permute2f128_pd::<0x20>(h01, h23);
+                let high = _mm256_permute2f128_pd::<0x31>(h01, h23);
+                _mm256_storeu_pd(po.add(r), _mm256_add_pd(low, high));
+                base = base.add(4 * stride);
+                r += 4;
+            }
+            while r < rows {
+                let mut acc = _mm256_setzero_pd();
+                let mut i = 0;
+                // two chunks per turn, added in order, as in `dot`
+                while i + 8 <= full {
+                    let (y, z) = (_mm256_loadu_pd(px.add(i)), _mm256_loadu_pd(px.add(i + 4)));
+                    acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(base.add(i)), y));
+                    acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(base.add(i + 4)), z));
+                    i += 8;
+                }
+                if i < full {
+                    let y = _mm256_loadu_pd(px.add(i));
+                    acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(base.add(i)), y));
+                }
+                if p > full {
+                    acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(base.add(full)), xt));
+                }
+                *po.add(r) = sum(acc);
+                base = base.add(stride);
                 r += 1;
             }
         }
@@ -1046,10 +1204,22 @@ mod tests {
                 let (mut o1, mut o2) = (vec![f64::NAN; rows], vec![f64::NAN; rows]);
                 Avx2::<()>::dots(&m, &a, &mut o1);
                 Portable::dots(&m, &a, &mut o2);
+                // the same rows laid out with zeros after each: the same bits
+                let padded = PaddedRows::new(n, (0..rows).map(|r| &m[r * n..(r + 1) * n]));
+                assert_eq!(padded.rows(), rows);
+                let (mut o3, mut o4) = (vec![f64::NAN; rows], vec![f64::NAN; rows]);
+                Avx2::<()>::padded_dots(&padded, &a, &mut o3);
+                Portable::padded_dots(&padded, &a, &mut o4);
                 for r in 0..rows {
                     let single = Portable::dot(&m[r * n..(r + 1) * n], &a);
-                    assert_eq!(o1[r].to_bits(), single.to_bits(), "{n} {rows} {r}");
-                    assert_eq!(o2[r].to_bits(), single.to_bits(), "{n} {rows} {r}");
+                    for (o, what) in [
+                        (&o1, "dots"),
+                        (&o2, "dots"),
+                        (&o3, "padded"),
+                        (&o4, "padded"),
+                    ] {
+                        assert_eq!(o[r].to_bits(), single.to_bits(), "{what} {n} {rows} {r}");
+                    }
                 }
             }
             let (mut q1, mut q2, mut s1, mut s2) =

@@ -27,10 +27,9 @@ use crate::structure::modal::Point;
 pub struct FrameRows {
     /// `[n·Φ_c, t₁·Φ_c, t₂·Φ_c]`, p values each; `n` is the obstacle's normal as declared
     /// (for bars, the normal of the side reached at `s < 0`).
-    rows: Vec<f64>,
-    /// The number of modes `p` (a third of `rows`, kept: detection slices a row per contact
-    /// per step).
-    p: usize,
+    /// (Three vectors, not one of `3p` values sliced at every use: a step takes a contact's
+    /// rows several times.)
+    rows: [Vec<f64>; 3],
     normal: Vector3<f64>,
     tangents: [Vector3<f64>; 2],
     /// `(x_c − x₀)·n`.
@@ -52,7 +51,7 @@ impl FrameRows {
         if contact.at_surface() {
             contact.surface_rows(point, &normal, &mut surface);
         }
-        let mut rows = vec![0.0; 3 * p];
+        let mut rows = [vec![0.0; p], vec![0.0; p], vec![0.0; p]];
         // the normal row from the point's own rows (n·(R n × Θ) = 0: the surface adds nothing
         // along the normal), the tangent rows from the contact point's
         for (d, (dir, src)) in [
@@ -63,14 +62,13 @@ impl FrameRows {
         .iter()
         .enumerate()
         {
-            let out = &mut rows[d * p..(d + 1) * p];
+            let out = &mut rows[d];
             for (i, o) in out.iter_mut().enumerate() {
                 *o = dir.x * src[i] + dir.y * src[p + i] + dir.z * src[2 * p + i];
             }
         }
         Some(Self {
             rows,
-            p,
             normal,
             tangents,
             offset: (point.coords - origin).dot(&normal),
@@ -85,16 +83,10 @@ impl FrameRows {
         if *normal == self.normal { 1.0 } else { -1.0 }
     }
 
-    #[inline(always)]
-    fn p(&self) -> usize {
-        self.p
-    }
-
     /// The row `n·Φ_c` (`a = 0`) or `t_a·Φ_c` (`a = 1, 2`).
     #[inline(always)]
     pub fn row(&self, a: usize) -> &[f64] {
-        let p = self.p();
-        &self.rows[a * p..(a + 1) * p]
+        &self.rows[a]
     }
 
     /// Signed distance `s` along the declared normal at time `t` for modal displacements `q`
@@ -108,12 +100,19 @@ impl FrameRows {
         motion: &Motion,
         t: f64,
     ) -> f64 {
-        let s = K::dot(self.row(0), q) + self.offset;
+        let s = self.distance_from_dot(K::dot(self.row(0), q));
         if fixed {
             s
         } else {
             s - motion.at(t).0.dot(&self.normal)
         }
+    }
+
+    /// The signed distance `s` of a fixed obstacle from the dot product `(n·Φ_c) q`
+    /// ([`Self::distance`] with the dot product formed by the caller).
+    #[inline(always)]
+    pub(crate) fn distance_from_dot(&self, dot: f64) -> f64 {
+        dot + self.offset
     }
 
     /// Sets the penetration and the normal of `frame` for the distance `s` (the obstacle's
@@ -143,20 +142,21 @@ impl FrameRows {
     }
 
     /// Tangential velocity relative to the obstacle, `v_t = T·(Φ_c q̇ − v̄)`, for modal
-    /// velocities `qd` and the obstacle's velocity `v̄`.
+    /// velocities `qd` and the obstacle's velocity `v̄` (`None` for a fixed obstacle: nothing
+    /// to subtract, and `T·Φ_c q̇ − 0` would be the same bits — the sums are never `−0`).
     #[inline(always)]
     pub(crate) fn tangential_velocity<K: Lanes>(
         &self,
         qd: &[f64],
-        obstacle: &Vector3<f64>,
+        obstacle: Option<&Vector3<f64>>,
     ) -> Vector2<f64> {
         // one pass over q̇ for both rows (a·b = b·a bit for bit: the same sums as two dots)
         let (t1, t2) = K::dot2(qd, self.row(1), self.row(2));
-        Vector2::new(t1, t2)
-            - Vector2::new(
-                self.tangents[0].dot(obstacle),
-                self.tangents[1].dot(obstacle),
-            )
+        let v = Vector2::new(t1, t2);
+        match obstacle {
+            Some(o) => v - Vector2::new(self.tangents[0].dot(o), self.tangents[1].dot(o)),
+            None => v,
+        }
     }
 
     /// Normal velocity relative to the obstacle along the frame's normal (positive away from

@@ -3,6 +3,8 @@
 
 use serde::Serialize;
 
+use crate::kernels::running_max;
+
 /// Discrete energy balance: `E(t) − E(0) − W_ext − W_fe + D`, with `E` kinetic + strain +
 /// normal penalty potential, `W_ext` the work of external loads, `W_fe` the work of the
 /// fluid-elastic forces and `D` the energy dissipated by
@@ -66,11 +68,11 @@ impl EnergyBalance {
         self.last = e;
         let residual = self.residual();
         // the running maximum starts at 0 and skips a NaN residual
-        self.max_abs = crate::kernels::running_max(self.max_abs, residual.abs());
-        self.scale = self
-            .scale
-            .max(e.abs())
-            .max(self.initial.abs() + self.external_work.abs() + self.fluid_work.abs());
+        self.max_abs = running_max(self.max_abs, residual.abs());
+        // (running maxima: the scale starts at |E(0)| and the step's values are never NaN — a
+        // step whose energy or powers are not finite has diverged before it is added)
+        let work = self.initial.abs() + self.external_work.abs() + self.fluid_work.abs();
+        self.scale = running_max(running_max(self.scale, e.abs()), work);
     }
 
     /// Sets [`Self::relative_error`] from the running maxima (once, when the balance is

@@ -4,13 +4,14 @@
 //! velocities.
 //!
 //! A plane or bars ([`FrameRows`]) is detected with one dot product on the modal
-//! displacements; other obstacles (holes) from the point's 3-D position. Velocities are
-//! formed for closed contacts only (and for every contact at an output sample), in the
-//! contact's frame.
+//! displacements (in the common case of four contacts or more, all of them in one pass over
+//! the modes, [`Simulation::detect_fixed`]); other obstacles (holes) from the point's 3-D
+//! position. Velocities are formed for closed contacts only (and for every contact at an
+//! output sample), in the contact's frame.
 
 use nalgebra::{Vector2, Vector3};
 
-use super::contact_kinds::ContactKinds;
+use super::contact_kinds::{CommonContacts, ContactKinds};
 use super::{ContactState, Simulation, Tangential, contact_rows, contact_states};
 use crate::contact::frame_rows::FrameRows;
 use crate::kernels::Lanes;
@@ -97,6 +98,11 @@ impl Simulation<'_> {
     /// most a quarter of the bound), checked here where the penetration is at hand.
     #[inline(always)]
     pub(super) fn detect<K: Lanes, O: ContactKinds>(&mut self, t: f64, predicted: bool) -> bool {
+        // four contacts or more: their dot products together (with fewer, the pass over `q`
+        // for all of them costs more than it saves)
+        if O::COMMON && self.normal_dots.len() >= 4 {
+            return self.detect_fixed::<K>();
+        }
         let velocity = if predicted {
             &self.cd.qd_star
         } else {
@@ -138,7 +144,7 @@ impl Simulation<'_> {
             match O::rows(&self.frame_rows[k]) {
                 Some(frame_rows) => {
                     state.set_velocity::<K>(
-                        Kinematics::Rows(frame_rows),
+                        Kinematics::Rows(frame_rows, O::is_fixed(c)),
                         O::damped(c),
                         velocity,
                         penalty,
@@ -171,6 +177,31 @@ impl Simulation<'_> {
         open_within
     }
 
+    /// [`Self::detect`] in the common case ([`CommonContacts`]: every obstacle a fixed plane
+    /// or fixed bars seen through its frame rows, an undamped normal law, friction by Lagrange
+    /// multipliers): every contact's dot product `(n·Φ_c) q` in one pass over `q`
+    /// ([`Lanes::padded_dots`], the bits of [`FrameRows::distance`]'s), then each contact's
+    /// penetration and normal force from its own — no velocity: without damping the normal
+    /// law does not use it, and the Lagrange methods form `L q̇*` themselves.
+    #[inline(always)]
+    fn detect_fixed<K: Lanes>(&mut self) -> bool {
+        self.closed.clear();
+        let mut detected = Detected {
+            closed: &mut self.closed,
+            quarter_bound: 0.25 * self.accumulation_bound,
+            open_within: true,
+        };
+        K::padded_dots(&self.normal_rows, &self.cd.q, &mut self.normal_dots);
+        let contacts = (self.model.contacts.iter())
+            .zip(&self.frame_rows)
+            .zip(&self.normal_dots);
+        for (k, (state, ((c, rows), &dot))) in self.contacts.iter_mut().zip(contacts).enumerate() {
+            let rows = CommonContacts::rows(rows).expect("a common step's contact has rows");
+            detected.contact(k, state, c, rows, dot);
+        }
+        detected.open_within
+    }
+
     /// Full-step velocities of the closed contacts (of all when `all`) relative to their
     /// obstacles: `Φ_c q̇_{n+1} − v̄_{n+1}`, with `v̄` the obstacle's full-step velocity
     /// ([`crate::contact::motion::Motion::full_step_velocity`], the mean of the two step velocities
@@ -200,7 +231,8 @@ impl Simulation<'_> {
         }
         match O::rows(&self.frame_rows[k]) {
             Some(rows) => {
-                state.set_velocity::<K>(Kinematics::Rows(rows), O::damped(c), &self.cd.qd, true)
+                let kinematics = Kinematics::Rows(rows, O::is_fixed(c));
+                state.set_velocity::<K>(kinematics, O::damped(c), &self.cd.qd, true)
             }
             None => {
                 let pt = &self.model.basis.points[c.point];
@@ -215,10 +247,52 @@ impl Simulation<'_> {
     }
 }
 
+/// What [`Simulation::detect_fixed`] finds, contact by contact.
+struct Detected<'a> {
+    /// The contacts closed so far, in order.
+    closed: &'a mut Vec<usize>,
+    /// A quarter of [`Simulation::accumulation_bound`].
+    quarter_bound: f64,
+    /// Whether every open contact so far can be accumulated (as in [`Simulation::detect`]).
+    open_within: bool,
+}
+
+impl Detected<'_> {
+    /// Contact `k` of a fixed plane or bars (`rows`) whose dot product `(n·Φ_c) q` is `dot`:
+    /// its distance, penetration, status and normal force ([`Simulation::detect`]'s, for a
+    /// contact of the common case).
+    #[inline(always)]
+    fn contact(
+        &mut self,
+        k: usize,
+        state: &mut ContactState,
+        c: &crate::contact::Contact,
+        rows: &FrameRows,
+        dot: f64,
+    ) {
+        state.tangential_force = Vector2::zeros();
+        state.held = false;
+        state.distance = rows.distance_from_dot(dot);
+        rows.update(state.distance, &mut state.frame);
+        state.closed = state.frame.penetration > 0.0;
+        if !state.closed {
+            state.normal_force = 0.0;
+            let d = state.frame.penetration;
+            self.open_within &= d * d <= self.quarter_bound;
+            return;
+        }
+        self.closed.push(k);
+        // no damping: the velocity is not formed
+        state.v_normal = 0.0;
+        state.normal_force = c.normal.force(state.frame.penetration, -state.v_normal);
+    }
+}
+
 /// How a contact's velocity is formed from the modal velocities.
 pub(super) enum Kinematics<'a> {
-    /// A plane or bars: its frame rows.
-    Rows(&'a FrameRows),
+    /// A plane or bars: its frame rows, and whether the obstacle is fixed (then its velocity,
+    /// zero, is not subtracted).
+    Rows(&'a FrameRows, bool),
     /// Any obstacle: the contact point's 3 × p rows.
     Point(&'a [f64]),
 }
@@ -239,9 +313,10 @@ impl ContactState {
         tangential: bool,
     ) {
         match kinematics {
-            Kinematics::Rows(rows) => {
+            Kinematics::Rows(rows, fixed) => {
                 if tangential {
-                    self.v_tangential = rows.tangential_velocity::<K>(qd, &self.frame.velocity);
+                    let obstacle = (!fixed).then_some(&self.frame.velocity);
+                    self.v_tangential = rows.tangential_velocity::<K>(qd, obstacle);
                 }
                 self.v_normal = if damped {
                     rows.normal_velocity::<K>(&self.frame, qd, &self.frame.velocity)

@@ -41,7 +41,7 @@ use crate::contact::tangential::{SolverStatistics, TangentialMethod};
 use crate::error::{Error, Result};
 use crate::integrator::central_difference::CentralDifference;
 use crate::integrator::stability::stable_time_step;
-use crate::kernels::{Lanes, Portable};
+use crate::kernels::{Lanes, PaddedRows, Portable};
 use crate::loads::fluid_elastic::{DelayHistory, FluidElasticForce};
 use crate::loads::stepped::SteppedHistory;
 use crate::model::Model;
@@ -194,6 +194,12 @@ pub struct Simulation<'m> {
     surface_rows: Vec<f64>,
     /// Per contact: the frame rows of a plane or bars, `None` for a hole.
     frame_rows: Vec<Option<FrameRows>>,
+    /// The common step's detection ([`contact_kinds::CommonContacts`]): every contact's
+    /// normal row `n·Φ_c` ([`FrameRows::row`]), laid out for one pass over `q` that forms
+    /// all their dot products ([`Lanes::padded_dots`]). Empty for the general step.
+    normal_rows: PaddedRows,
+    /// Work space of that detection: `normal_rows q`, one value per contact.
+    normal_dots: Vec<f64>,
     /// The fluid-elastic force with its past displacements, when the model has one.
     fluid: Option<FluidElasticForce>,
     /// Modal loads `Φ_lᵀ F_l`, one row of p per load.
@@ -573,6 +579,12 @@ impl<'m> Simulation<'m> {
         }
         let common_contacts =
             contact_kinds::is_common(&model.contacts, &frame_rows, &settings.method);
+        let normal_rows = if common_contacts {
+            let rows: Vec<&[f64]> = frame_rows.iter().flatten().map(|r| r.row(0)).collect();
+            PaddedRows::new(p, rows.into_iter())
+        } else {
+            PaddedRows::default()
+        };
         Ok(Self {
             model,
             settings,
@@ -582,6 +594,8 @@ impl<'m> Simulation<'m> {
             tangential,
             surface_rows,
             frame_rows,
+            normal_dots: vec![0.0; normal_rows.rows()],
+            normal_rows,
             fluid,
             load_rows,
             load_histories: (model.loads.iter().map(|l| &l.history))
