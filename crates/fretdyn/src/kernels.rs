@@ -29,8 +29,9 @@ pub(crate) trait Lanes: Copy {
     /// serves four rows.
     fn dots(a: &[f64], x: &[f64], out: &mut [f64]);
     /// [`Self::dots`] on rows laid out by [`PaddedRows`] (`x` of the rows' length `p`; all 0
-    /// when it is shorter): `out[r] = A_r·x` for the first `out.len()` rows, each summed
-    /// exactly as [`Self::dot`] sums it. The zeros after each row let the AVX2 code read
+    /// when it is shorter): `out[r] = A_r·x` for `r` below both `out.len()` and the number of
+    /// rows (`out`'s other values are left as they are), each summed exactly as [`Self::dot`]
+    /// sums it. The zeros after each row let the AVX2 code read
     /// `x`'s last `p mod 4` values once for all rows, and it adds the lanes of four rows at
     /// a time in one pass.
     fn padded_dots(a: &PaddedRows, x: &[f64], out: &mut [f64]);
