@@ -50,10 +50,12 @@ pub struct TangentialProblem {
     h: Vec<f64>,
     /// Right-hand side `b`, by slot rows.
     b: Vec<f64>,
-    /// `H_kk` of each slot, prepared for its local solve.
-    diagonal: Vec<DiagonalBlock>,
-    /// `H_cc` of each fixed contact, prepared once ([`Self::fix_rows`]).
-    diagonal_fixed: Vec<DiagonalBlock>,
+    /// The diagonal blocks prepared for their local solves: `H_cc` of fixed contact `c` at
+    /// `c`, prepared once ([`Self::fix_rows`]); `H_kk` of the other slots at `contacts + k`,
+    /// prepared by [`Self::assemble`].
+    blocks: Vec<DiagonalBlock>,
+    /// Per slot, the index of its diagonal block in `blocks` ([`Self::diagonal_block`]).
+    block_of: Vec<usize>,
     /// Per slot, the Newton start of its exact slip solve within the step
     /// ([`crate::contact::friction::local_solve_block`]); reset by [`Self::assemble`].
     newton: Vec<Cell<f64>>,
@@ -86,8 +88,8 @@ impl TangentialProblem {
             h_fixed: vec![0.0; rows * rows],
             h: vec![0.0; rows * rows],
             b: vec![0.0; rows],
-            diagonal: vec![DiagonalBlock::default(); contacts],
-            diagonal_fixed: vec![DiagonalBlock::default(); contacts],
+            blocks: vec![DiagonalBlock::default(); 2 * contacts],
+            block_of: Vec::with_capacity(contacts),
             newton: vec![Cell::new(f64::NAN); contacts],
             sweep: vec![Cell::new([Vector2::zeros(); 2]); contacts],
             stride: rows,
@@ -138,7 +140,7 @@ impl TangentialProblem {
             self.h_fixed[(r + 1) * st + r],
             self.h_fixed[(r + 1) * st + r + 1],
         );
-        self.diagonal_fixed[contact] = DiagonalBlock::new(h);
+        self.blocks[contact] = DiagonalBlock::new(h);
     }
 
     #[inline(always)]
@@ -159,16 +161,11 @@ impl TangentialProblem {
         }
     }
 
-    /// Row of `L` (in the per-contact layout) of slot row `r`.
-    #[inline]
-    fn contact_row(&self, r: usize) -> usize {
-        2 * self.slots[r / 2].contact + r % 2
-    }
-
     /// Removes every slot.
     #[inline]
     pub fn clear(&mut self) {
         self.slots.clear();
+        self.block_of.clear();
         self.all_fixed = true;
     }
 
@@ -212,10 +209,14 @@ impl TangentialProblem {
         rows: &[f64],
         apply_a_inv: impl Fn(&[f64], &mut [f64]),
     ) {
-        if !self.fixed[slot.contact] {
+        let block = if self.fixed[slot.contact] {
+            slot.contact
+        } else {
             self.compute_rows(slot.contact, tangents, rows, apply_a_inv);
             self.all_fixed = false;
-        }
+            self.fixed.len() + self.slots.len()
+        };
+        self.block_of.push(block);
         self.slots.push(slot);
     }
 
@@ -302,7 +303,7 @@ impl TangentialProblem {
             self.newton[k].set(f64::NAN);
             if !fixed_k {
                 // a fixed contact's block was prepared once ([`Self::diagonal_block`])
-                self.diagonal[k] = DiagonalBlock::new(self.block(k, k));
+                self.blocks[self.block_of[k]] = DiagonalBlock::new(self.block(k, k));
             }
         }
     }
@@ -334,12 +335,7 @@ impl TangentialProblem {
     /// ([`Self::fix_rows`]), by [`Self::assemble`] for the others.
     #[inline]
     pub fn diagonal_block(&self, k: usize) -> &DiagonalBlock {
-        let c = self.slots[k].contact;
-        if self.fixed[c] {
-            &self.diagonal_fixed[c]
-        } else {
-            &self.diagonal[k]
-        }
+        &self.blocks[self.block_of[k]]
     }
 
     /// `b_k`.
@@ -371,10 +367,11 @@ impl TangentialProblem {
         Vector2::new(c0, c1)
     }
 
-    /// `(b − Hλ)_k`: contact k's tangential velocity relative to the obstacle, divided by θΔt.
+    /// `(b − Hλ)_k`: contact k's tangential velocity relative to the obstacle, divided by θΔt
+    /// (`H_kk` read from its prepared block: the numbers of [`Self::block`]`(k, k)`, one load).
     #[inline]
     pub fn residual_velocity(&self, k: usize, lambda: &[Vector2<f64>]) -> Vector2<f64> {
-        self.local_rhs(k, lambda) - self.block(k, k) * lambda[k]
+        self.local_rhs(k, lambda) - self.diagonal_block(k).h * lambda[k]
     }
 
     /// Natural-map residual of the tangential problem (THEORY §4.2), the same measure for
@@ -455,7 +452,7 @@ impl TangentialProblem {
             return self.single_residual(lambda[0], self.rhs(0), slide[0]);
         }
         self.natural_map(lambda, slide, |k| match rhs(k) {
-            Some(c) => c - self.block(k, k) * lambda[k],
+            Some(c) => c - self.diagonal_block(k).h * lambda[k],
             None => self.residual_velocity(k, lambda),
         })
     }
@@ -491,11 +488,10 @@ impl TangentialProblem {
     #[inline(always)]
     pub(crate) fn apply<K: crate::kernels::Lanes>(&self, lambda: &[Vector2<f64>], qdd: &mut [f64]) {
         let p = self.p;
-        for (k, lam) in lambda.iter().enumerate().take(self.slots.len()) {
-            for a in 0..2 {
-                let r = self.contact_row(2 * k + a);
-                let al = &self.al[r * p..(r + 1) * p];
-                let s = lam[a];
+        for (slot, lam) in self.slots.iter().zip(lambda) {
+            // the contact's two rows, side by side
+            let rows = &self.al[2 * slot.contact * p..][..2 * p];
+            for (al, s) in rows.chunks_exact(p.max(1)).zip([lam.x, lam.y]) {
                 if s != 0.0 {
                     K::axpy(qdd, -s, al);
                 }

@@ -71,16 +71,21 @@ impl Simulation<'_> {
             Vector2::new(f.tangents[0].dot(&v), f.tangents[1].dot(&v))
         });
         let m = problem.len();
+        let warm = match solver {
+            LagrangeSolver::GaussSeidel(s) => s.warm_start,
+            LagrangeSolver::ActiveSet(_) => false,
+        };
         for (k, slot) in problem.slots().iter().enumerate() {
-            let warm = match solver {
-                LagrangeSolver::GaussSeidel(s) => s.warm_start,
-                LagrangeSolver::ActiveSet(_) => false,
-            };
-            lambda[k] = if warm && history[slot.contact].closed {
+            let before = &history[slot.contact];
+            lambda[k] = if warm && before.closed {
                 previous_lambda[slot.contact]
             } else {
                 Vector2::zeros()
             };
+            // held: both half-step velocities of q̇_{n+1} imposed (only this step's with the
+            // full-step constraint) — the previous step's part here, this step's stick below
+            self.contacts[slot.contact].held =
+                !half_step || (before.closed && before.slide == Slide::Stick);
         }
         self.solver_stats.lagrange_steps += 1;
         let mut residual = None;
@@ -117,19 +122,13 @@ impl Simulation<'_> {
             residual.unwrap_or_else(|| problem.natural_map_residual(&lambda[..m], &slide[..m]));
         self.solver_stats.add_residual(residual);
         problem.apply::<K>(&lambda[..m], &mut self.cd.qdd);
-        for (k, slot) in problem.slots().iter().enumerate() {
-            // held: both half-step velocities of q̇_{n+1} imposed (only this step's with the
-            // full-step constraint)
-            let before = &history[slot.contact];
-            self.contacts[slot.contact].held = slide[k] == Slide::Stick
-                && (!half_step || (before.closed && before.slide == Slide::Stick));
-        }
         history.iter_mut().for_each(|h| h.closed = false);
         let active_set = matches!(solver, LagrangeSolver::ActiveSet(_));
         for (k, slot) in problem.slots().iter().enumerate() {
             let state = &mut self.contacts[slot.contact];
             state.tangential_force = -lambda[k];
             state.slide = slide[k];
+            state.held &= slide[k] == Slide::Stick;
             // the slip direction serves the Active Set's first guess only
             let n = if active_set { lambda[k].norm() } else { 0.0 };
             history[slot.contact] = History {
