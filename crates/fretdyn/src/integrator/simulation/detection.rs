@@ -111,8 +111,11 @@ impl Simulation<'_> {
         let p = self.cd.q.len();
         let penalty = O::penalty(matches!(self.tangential, Tangential::Penalty { .. }));
         self.closed.clear();
-        let quarter_bound = 0.25 * self.accumulation_bound;
-        let mut open_within = true;
+        let mut detected = Detected {
+            closed: &mut self.closed,
+            quarter_bound: 0.25 * self.accumulation_bound,
+            open_within: true,
+        };
         for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
             state.tangential_force = Vector2::zeros();
             state.held = false;
@@ -127,15 +130,9 @@ impl Simulation<'_> {
                     state.frame = c.frame(&state.x, t);
                 }
             }
-            state.closed = state.frame.penetration > 0.0;
-            if !state.closed {
-                state.normal_force = 0.0;
-                // no forces, no velocity: `accumulable` reduces to this (a NaN fails it)
-                let d = state.frame.penetration;
-                open_within &= d * d <= quarter_bound;
+            if !detected.status(k, state) {
                 continue;
             }
-            self.closed.push(k);
             let pt = &self.model.basis.points[c.point];
             // an open contact's velocity is only needed at output samples
             if !O::is_fixed(c) {
@@ -174,7 +171,7 @@ impl Simulation<'_> {
                 state.x_relative = pt.coords + recombine_with::<K>(rows, &self.cd.q) - d;
             }
         }
-        open_within
+        detected.open_within
     }
 
     /// [`Self::detect`] in the common case ([`CommonContacts`]: every obstacle a fixed plane
@@ -247,17 +244,35 @@ impl Simulation<'_> {
     }
 }
 
-/// What [`Simulation::detect_fixed`] finds, contact by contact.
+/// What detection ([`Simulation::detect`], [`Simulation::detect_fixed`]) finds, contact by
+/// contact.
 struct Detected<'a> {
     /// The contacts closed so far, in order.
     closed: &'a mut Vec<usize>,
     /// A quarter of [`Simulation::accumulation_bound`].
     quarter_bound: f64,
-    /// Whether every open contact so far can be accumulated (as in [`Simulation::detect`]).
+    /// Whether every open contact so far can be accumulated ([`ContactState::accumulable`]).
     open_within: bool,
 }
 
 impl Detected<'_> {
+    /// Contact `k`'s status from its penetration (its frame at hand): an open contact's
+    /// normal force is zero and its penetration is checked against the bound, a closed one
+    /// joins the closed contacts. Returns whether it is closed.
+    #[inline(always)]
+    fn status(&mut self, k: usize, state: &mut ContactState) -> bool {
+        state.closed = state.frame.penetration > 0.0;
+        if !state.closed {
+            state.normal_force = 0.0;
+            // no forces, no velocity: `accumulable` reduces to this (a NaN fails it)
+            let d = state.frame.penetration;
+            self.open_within &= d * d <= self.quarter_bound;
+            return false;
+        }
+        self.closed.push(k);
+        true
+    }
+
     /// Contact `k` of a fixed plane or bars (`rows`) whose dot product `(n·Φ_c) q` is `dot`:
     /// its distance, penetration, status and normal force ([`Simulation::detect`]'s, for a
     /// contact of the common case).
@@ -274,14 +289,9 @@ impl Detected<'_> {
         state.held = false;
         state.distance = rows.distance_from_dot(dot);
         rows.update(state.distance, &mut state.frame);
-        state.closed = state.frame.penetration > 0.0;
-        if !state.closed {
-            state.normal_force = 0.0;
-            let d = state.frame.penetration;
-            self.open_within &= d * d <= self.quarter_bound;
+        if !self.status(k, state) {
             return;
         }
-        self.closed.push(k);
         // no damping: the velocity is not formed
         state.v_normal = 0.0;
         state.normal_force = c.normal.force(state.frame.penetration, -state.v_normal);
