@@ -68,6 +68,22 @@ pub(crate) trait Lanes: Copy {
         c: &[f64],
         vs: &[f64],
     );
+    /// [`Self::free_acceleration`] of the force `f_i + s x_i`, not formed: `out_i = ai_i
+    /// (((f_i + s x_i) − w2_i q_i) − c_i vs_i)`, the bits of [`Self::axpy`] into a copy of `f`
+    /// then [`Self::free_acceleration`] (a step's modal force with one closed contact in one
+    /// pass over the modes instead of three; slices of equal length).
+    #[allow(clippy::too_many_arguments)]
+    fn free_acceleration_plus(
+        out: &mut [f64],
+        ai: &[f64],
+        f: &[f64],
+        s: f64,
+        x: &[f64],
+        w2: &[f64],
+        q: &[f64],
+        c: &[f64],
+        vs: &[f64],
+    );
     /// Writes `v_i = vs_i + h a_i` to `v` and returns `(½ Σ (v_i² + w2_i q_i²), Σ c_i v_i²,
     /// Σ f_i v_i)`: the velocity update of central differences with the structure's energy,
     /// its damping power and the power of the force `f` (slices of equal length).
@@ -320,6 +336,26 @@ impl Lanes for Portable {
     }
 
     #[inline(always)]
+    fn free_acceleration_plus(
+        out: &mut [f64],
+        ai: &[f64],
+        f: &[f64],
+        s: f64,
+        x: &[f64],
+        w2: &[f64],
+        q: &[f64],
+        c: &[f64],
+        vs: &[f64],
+    ) {
+        let p = out.len();
+        let (ai, f, x, w2) = (&ai[..p], &f[..p], &x[..p], &w2[..p]);
+        let (q, c, vs) = (&q[..p], &c[..p], &vs[..p]);
+        for i in 0..p {
+            out[i] = ai[i] * ((f[i] + s * x[i]) - w2[i] * q[i] - c[i] * vs[i]);
+        }
+    }
+
+    #[inline(always)]
     fn correct_with_energy(
         v: &mut [f64],
         vs: &[f64],
@@ -485,7 +521,23 @@ impl<Tag> Lanes for Avx2<Tag> {
         vs: &[f64],
     ) {
         // SAFETY: as above
-        unsafe { avx2::free_acceleration::<Tag>(out, ai, f, w2, q, c, vs) }
+        unsafe { avx2::free_acceleration::<Tag, false>(out, ai, f, 0.0, f, w2, q, c, vs) }
+    }
+
+    #[inline(always)]
+    fn free_acceleration_plus(
+        out: &mut [f64],
+        ai: &[f64],
+        f: &[f64],
+        s: f64,
+        x: &[f64],
+        w2: &[f64],
+        q: &[f64],
+        c: &[f64],
+        vs: &[f64],
+    ) {
+        // SAFETY: as above
+        unsafe { avx2::free_acceleration::<Tag, true>(out, ai, f, s, x, w2, q, c, vs) }
     }
 
     #[inline(always)]
@@ -975,7 +1027,8 @@ mod avx2 {
         }
     }
 
-    /// [`super::Portable::free_acceleration`] on AVX2: four modes at a time; the last
+    /// [`super::Portable::free_acceleration`] on AVX2 (with [`super::Portable::free_acceleration_plus`]'s
+    /// `f_i + s x_i` when `PLUS`; `x` is not read otherwise): four modes at a time; the last
     /// `p mod 4` as part of the last four modes `p − 4..p` again when `p ≥ 4`, else by
     /// [`tail`] and [`store_first`].
     ///
@@ -985,10 +1038,12 @@ mod avx2 {
     #[target_feature(enable = "avx2")]
     #[allow(clippy::too_many_arguments)]
     #[allow(clippy::extra_unused_type_parameters)] // `Tag`: a copy per caller ([`super::Avx2`])
-    pub(super) unsafe fn free_acceleration<Tag>(
+    pub(super) unsafe fn free_acceleration<Tag, const PLUS: bool>(
         out: &mut [f64],
         ai: &[f64],
         f: &[f64],
+        s: f64,
+        x: &[f64],
         w2: &[f64],
         q: &[f64],
         c: &[f64],
@@ -996,9 +1051,23 @@ mod avx2 {
     ) {
         let p = out.len();
         let (ai, f, w2, q, c, vs) = (&ai[..p], &f[..p], &w2[..p], &q[..p], &c[..p], &vs[..p]);
+        let x = if PLUS { &x[..p] } else { x };
         let full = p - p % 4;
-        // SAFETY: as in `predict`
+        // SAFETY: as in `predict` (`x` of length p when `PLUS`)
         unsafe {
+            let sv = _mm256_set1_pd(s);
+            // the force f + s x (f alone unless `PLUS`)
+            let force = |f: __m256d, at: *const f64, tail_of: Option<usize>| {
+                if PLUS {
+                    let xi = match tail_of {
+                        Some(m) => tail(at, m),
+                        None => _mm256_loadu_pd(at),
+                    };
+                    _mm256_add_pd(f, _mm256_mul_pd(sv, xi))
+                } else {
+                    f
+                }
+            };
             let value = |ai: __m256d, f: __m256d, w2: __m256d, q: __m256d, c: __m256d, vs| {
                 _mm256_mul_pd(
                     ai,
@@ -1009,7 +1078,7 @@ mod avx2 {
             while i < full {
                 let x = value(
                     _mm256_loadu_pd(ai.as_ptr().add(i)),
-                    _mm256_loadu_pd(f.as_ptr().add(i)),
+                    force(_mm256_loadu_pd(f.as_ptr().add(i)), x.as_ptr().add(i), None),
                     _mm256_loadu_pd(w2.as_ptr().add(i)),
                     _mm256_loadu_pd(q.as_ptr().add(i)),
                     _mm256_loadu_pd(c.as_ptr().add(i)),
@@ -1025,7 +1094,7 @@ mod avx2 {
                 let j = p - 4;
                 let x = value(
                     _mm256_loadu_pd(ai.as_ptr().add(j)),
-                    _mm256_loadu_pd(f.as_ptr().add(j)),
+                    force(_mm256_loadu_pd(f.as_ptr().add(j)), x.as_ptr().add(j), None),
                     _mm256_loadu_pd(w2.as_ptr().add(j)),
                     _mm256_loadu_pd(q.as_ptr().add(j)),
                     _mm256_loadu_pd(c.as_ptr().add(j)),
@@ -1036,7 +1105,7 @@ mod avx2 {
                 let m = p - full;
                 let x = value(
                     tail(ai.as_ptr().add(full), m),
-                    tail(f.as_ptr().add(full), m),
+                    force(tail(f.as_ptr().add(full), m), x.as_ptr().add(full), Some(m)),
                     tail(w2.as_ptr().add(full), m),
                     tail(q.as_ptr().add(full), m),
                     tail(c.as_ptr().add(full), m),
@@ -1242,7 +1311,16 @@ mod tests {
             let (mut a1, mut a2) = (vec![0.0; n], vec![0.0; n]);
             Avx2::<()>::free_acceleration(&mut a1, &w2, &f, &damping, &q, &b, &c);
             Portable::free_acceleration(&mut a2, &w2, &f, &damping, &q, &b, &c);
+            // the force f + s x not formed: the bits of axpy into a copy of f, then the above
+            let (mut a3, mut a4, mut a5) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            let mut force = f.clone();
+            Portable::axpy(&mut force, -1.3, &a);
+            Portable::free_acceleration(&mut a5, &w2, &force, &damping, &q, &b, &c);
+            Avx2::<()>::free_acceleration_plus(&mut a3, &w2, &f, -1.3, &a, &damping, &q, &b, &c);
+            Portable::free_acceleration_plus(&mut a4, &w2, &f, -1.3, &a, &damping, &q, &b, &c);
             let all = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(all(&a3), all(&a5), "{n}");
+            assert_eq!(all(&a4), all(&a5), "{n}");
             assert_eq!(all(&q1), all(&q2), "{n}");
             assert_eq!(all(&s1), all(&s2), "{n}");
             for (x, y) in [

@@ -507,15 +507,26 @@ impl TangentialProblem {
     /// contacts are closed: the factorisation is then redone only when that set changes
     /// (at an impact or a release), and the last answer is given otherwise. More than `p`
     /// rows (2m > p) make `H` singular by its rank: no factorisation then (THEORY §4.6).
+    #[inline(always)]
     pub fn is_singular(&mut self, work: &mut [f64]) -> bool {
-        let n = 2 * self.slots.len();
-        if n == 0 {
+        if self.slots.is_empty() {
             return false;
         }
-        let all_fixed = self.all_fixed;
-        if all_fixed && self.singular.is_some() && same_contacts(&self.singular_for, &self.slots) {
-            return self.singular == Some(true);
+        // the last answer (in line: the common case of a step)
+        match self.singular {
+            Some(singular) if self.all_fixed && same_contacts(&self.singular_for, &self.slots) => {
+                singular
+            }
+            _ => self.test_singular(work),
         }
+    }
+
+    /// [`Self::is_singular`] when its last answer does not serve: the test, kept for the
+    /// closed contacts when their rows are fixed.
+    #[inline(never)]
+    fn test_singular(&mut self, work: &mut [f64]) -> bool {
+        let n = 2 * self.slots.len();
+        let all_fixed = self.all_fixed;
         // H = L A⁻¹ Lᵀ has rank at most p: more than p rows of L are dependent, and the
         // factorisation would only confirm it
         let singular = n > self.p || self.factor_singular(work, n);

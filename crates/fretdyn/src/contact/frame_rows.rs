@@ -171,6 +171,17 @@ impl FrameRows {
         self.sign(&frame.normal) * (K::dot(self.row(0), qd) - self.normal.dot(obstacle))
     }
 
+    /// The normal force's modal force `Φ_cᵀ R_N n = s (n·Φ_c)ᵀ` as its coefficient `s` and
+    /// row `n·Φ_c`, for the frame's normal `normal` (the declared one or its opposite).
+    #[inline(always)]
+    pub(crate) fn normal_projection(
+        &self,
+        normal: &Vector3<f64>,
+        normal_force: f64,
+    ) -> (f64, &[f64]) {
+        (self.sign(normal) * normal_force, self.row(0))
+    }
+
     /// `f += Φ_cᵀ (R_N n + T R_T)` for the frame's normal `normal` (the declared one or its
     /// opposite).
     #[inline(always)]
@@ -181,7 +192,8 @@ impl FrameRows {
         tangential: &Vector2<f64>,
         f: &mut [f64],
     ) {
-        K::axpy(f, self.sign(normal) * normal_force, self.row(0));
+        let (s, row) = self.normal_projection(normal, normal_force);
+        K::axpy(f, s, row);
         if tangential.x != 0.0 {
             K::axpy(f, tangential.x, self.row(1));
         }

@@ -204,6 +204,39 @@ impl CentralDifference {
         }
     }
 
+    /// [`Self::free_acceleration_with`] of the force `force + s x` without forming it
+    /// ([`Lanes::free_acceleration_plus`], the same bits); `false`, with nothing done, for
+    /// dense operators (the caller then forms the force).
+    #[inline(always)]
+    pub(crate) fn free_acceleration_plus_with<K: Lanes>(
+        &mut self,
+        force: &[f64],
+        s: f64,
+        x: &[f64],
+    ) -> bool {
+        match &self.operators {
+            Operators::Modal {
+                omega2,
+                damping,
+                a_inv,
+            } => {
+                K::free_acceleration_plus(
+                    &mut self.qdd,
+                    a_inv,
+                    force,
+                    s,
+                    x,
+                    omega2,
+                    &self.q,
+                    damping,
+                    &self.qd_star,
+                );
+                true
+            }
+            Operators::Dense { .. } => false,
+        }
+    }
+
     /// `out = A⁻¹ l`: how a force `l` on the coordinates changes the acceleration.
     #[inline]
     pub fn apply_a_inv(&self, l: &[f64], out: &mut [f64]) {

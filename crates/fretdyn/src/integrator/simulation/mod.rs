@@ -766,12 +766,7 @@ impl<'m> Simulation<'m> {
             self.fluid_elastic_force::<K>(self.step, true);
         }
         let open_within = self.detect::<K, O>(t, true);
-        self.contact_forces::<K, O>();
-        self.cd.free_acceleration_with::<K>(normal::modal_force(
-            &self.closed,
-            &self.external,
-            &self.force,
-        ));
+        self.free_acceleration::<K, O>();
         self.lagrange::<K>();
         let modal = self.cd.correct_with::<K>(&self.external);
         self.full_step_velocities::<K, O>(false);

@@ -54,6 +54,32 @@ impl Simulation<'_> {
     }
 }
 
+impl Simulation<'_> {
+    /// Steps 4–5: the modal force ([`Self::contact_forces`]) and the free acceleration. With
+    /// one closed contact of the common case (a fixed plane's or bars' row, no tangential
+    /// force before the Lagrange solve) in one pass over the modes, the force `f_ext + s (n·Φ_c)ᵀ`
+    /// not formed ([`Lanes::free_acceleration_plus`]: the same bits).
+    #[inline(always)]
+    pub(super) fn free_acceleration<K: Lanes, O: ContactKinds>(&mut self) {
+        if let (true, &[k]) = (O::COMMON, self.closed.as_slice()) {
+            if let Some(rows) = O::rows(&self.frame_rows[k]) {
+                let state = &self.contacts[k];
+                debug_assert_eq!(state.tangential_force, nalgebra::Vector2::zeros());
+                let (s, row) = rows.normal_projection(&state.frame.normal, state.normal_force);
+                if self
+                    .cd
+                    .free_acceleration_plus_with::<K>(&self.external, s, row)
+                {
+                    return;
+                }
+            }
+        }
+        self.contact_forces::<K, O>();
+        self.cd
+            .free_acceleration_with::<K>(modal_force(&self.closed, &self.external, &self.force));
+    }
+}
+
 /// The modal force of the step: the external force when no contact is closed, else the one
 /// [`Simulation::contact_forces`] formed.
 #[inline(always)]
