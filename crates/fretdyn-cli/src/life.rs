@@ -7,21 +7,68 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use fretdyn::apps::life::{LifeEnd, LifeResults, LifeStep, YEAR, service_life};
+use fretdyn::apps::life::{
+    LifeCheckpoint, LifeControl, LifeEnd, LifeResults, LifeStep, YEAR, service_life_with,
+};
 use fretdyn::case::Case;
 
 use crate::Failure;
 use crate::out::{errln, outln};
 use crate::plot::{self, Series};
 
+/// Most halvings of `--halvings` (each about doubles the life steps of the one before).
+pub const MAX_HALVINGS: u32 = 10;
+
+/// The file that records which case a life's folder belongs to, for `--resume`.
+const LIFE_RUN_FILE: &str = "life_run.json";
+
+/// The checkpoint of a life ([`fretdyn::apps::life::LifeCheckpoint`]).
+const CHECKPOINT_FILE: &str = "life_checkpoint.bin";
+
+/// What a life writes in its folder (removed when a new life starts there, so that a folder
+/// never mixes two lives).
+const OUTPUTS: [&str; 6] = [
+    "life.csv",
+    "life.json",
+    "scars.csv",
+    "life.png",
+    "convergence.csv",
+    "convergence.png",
+];
+
+/// Options of `fretdyn life`.
+pub struct Options {
+    pub case: Option<PathBuf>,
+    pub resume: Option<PathBuf>,
+    pub output: Option<PathBuf>,
+    pub plots: bool,
+    pub halvings: u32,
+    /// Wall-clock seconds between checkpoints inside a window.
+    pub checkpoint_seconds: f64,
+}
+
 /// Entry point of `fretdyn life`.
-pub fn main(
-    path: &Path,
-    output: Option<PathBuf>,
-    plots: bool,
-    halvings: u32,
-) -> Result<(), Failure> {
-    let case = Case::from_file(path).map_err(|e| Failure::input(e.in_file(path)))?;
+pub fn main(o: &Options) -> Result<(), Failure> {
+    let (path, dir) = match (&o.case, &o.resume) {
+        (Some(path), None) => {
+            let stem = path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "case".into());
+            let dir = o
+                .output
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("fretdyn_results").join(format!("{stem}_life")));
+            (path.clone(), dir)
+        }
+        (None, Some(dir)) => (recorded_case(dir)?, dir.clone()),
+        _ => {
+            return Err(Failure::input(
+                "give either a case file or --resume DIR (the folder knows its case file)",
+            ));
+        }
+    };
+    let case = Case::from_file(&path).map_err(|e| Failure::input(e.in_file(&path)))?;
     for w in &case.warnings {
         errln!("warning: {w}");
     }
@@ -31,29 +78,45 @@ pub fn main(
             path.display()
         )));
     };
-    let stem = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "case".into());
-    let dir =
-        output.unwrap_or_else(|| PathBuf::from("fretdyn_results").join(format!("{stem}_life")));
-    std::fs::create_dir_all(&dir).map_err(|e| {
-        Failure::failed(format!("{}: cannot create the folder: {e}", dir.display()))
-    })?;
+    let (fingerprint, _) = crate::run::fingerprint_of(&path)?;
+    let _lock = crate::folder::lock(&dir, "life")?;
+    let checkpoint = dir.join(CHECKPOINT_FILE);
+    let resume = match &o.resume {
+        Some(_) => Some(read_checkpoint(&dir, &path, fingerprint)?),
+        None => {
+            start_afresh(&dir, &path, fingerprint)?;
+            None
+        }
+    };
+    let window = case.settings.steps as f64 * case.settings.dt;
     outln!(
         "{}: service life to {} years, windows of {} s, depth change ≤ {} per step{}",
         case.title,
-        life.target / YEAR,
-        case.settings.steps as f64 * case.settings.dt,
-        life.max_depth_change,
+        readable(life.target / YEAR),
+        readable(window),
+        readable(life.max_depth_change),
         if life.feedback {
             ""
         } else {
             " (fixed gap: no feedback)"
         }
     )?;
+    if let Some(r) = &resume {
+        outln!(
+            "  resumed from its checkpoint at {:.4} years",
+            r.time() / YEAR
+        )?;
+    }
+    let _keeping = crate::signals::Keeping::start();
+    let mut control = LifeControl {
+        checkpoint: Some(&checkpoint),
+        checkpoint_every_seconds: o.checkpoint_seconds,
+        fingerprint,
+        resume,
+        stop: Some(&crate::signals::INTERRUPTED),
+    };
     let mut printed = Ok(());
-    let results = service_life(&case, &life, |step: &LifeStep| {
+    let results = service_life_with(&case, &life, &mut control, |step: &LifeStep| {
         if printed.is_ok() && step.time > 0.0 {
             let depths: Vec<String> = step
                 .contacts
@@ -67,10 +130,27 @@ pub fn main(
             );
         }
     })
-    .map_err(|e| Failure::input(e.in_file(path)))?;
+    .map_err(|e| match e {
+        fretdyn::Error::Io { .. } => Failure::failed(format!(
+            "{}: {e}; once fixed (room on the disk), continue the life with: fretdyn life --resume {}",
+            path.display(),
+            dir.display()
+        )),
+        e => Failure::input(e.in_file(&path)),
+    })?;
     printed?;
-    write(&dir, &results, life.criterion)?;
-    if plots {
+    write(&dir, &results, life.criterion).map_err(|e| {
+        if checkpoint.exists() {
+            Failure::failed(format!(
+                "{}; the life is kept in its checkpoint: once there is room on the disk, write its results with: fretdyn life --resume {}",
+                e.message,
+                dir.display()
+            ))
+        } else {
+            e
+        }
+    })?;
+    if o.plots {
         draw(&dir.join("life.png"), &case.title, &results, life.criterion)
             .map_err(|e| Failure::failed(format!("{}: {e}", dir.join("life.png").display())))?;
     }
@@ -98,29 +178,39 @@ pub fn main(
         results.wall_time,
         dir.display()
     )?;
-    if halvings > 0 {
-        convergence(&case, &life, &results, halvings, &dir, plots)
-            .map_err(|e| Failure::input(e.in_file(path)))??;
+    if !matches!(results.end, LifeEnd::Stopped { .. }) {
+        // the life is over: nothing to resume
+        let _ = std::fs::remove_file(&checkpoint);
     }
-    match &results.end {
+    let source = path.display();
+    let end = match &results.end {
         LifeEnd::Completed => Ok(()),
         LifeEnd::Perforated { contact, time } => outln!(
-            "the tube at '{contact}' is worn through its wall at {:.4} years: the life stops there",
-            time / YEAR
+            "the tube at '{contact}' is worn through its wall at {}: the life stops there",
+            when(*time)
         ),
         LifeEnd::StepLimit => Err(Failure::failed(format!(
-            "{}: life: the target was not reached in max_steps = {} life steps: raise life.max_steps or life.max_depth_change (results so far written)",
-            path.display(),
-            life.max_steps
+            "{source}: life: the target was not reached in max_steps = {} life steps (at {}): raise life.max_steps or life.max_depth_change (results so far written)",
+            life.max_steps,
+            when(results.steps.last().map_or(0.0, |s| s.time))
         ))),
         LifeEnd::ScarLimit {
             contact,
             time,
             message,
         } => Err(Failure::failed(format!(
-            "{}: life: at {:.4} years the scar of contact '{contact}' reached the limit of its geometry ({message}); results so far written",
-            path.display(),
-            time / YEAR
+            "{source}: life: at {} the scar of contact '{contact}' reached the limit of its geometry ({message}); results so far written",
+            when(*time)
+        ))),
+        LifeEnd::StepTooShort {
+            contact,
+            time,
+            step,
+            depth,
+        } => Err(Failure::failed(format!(
+            "{source}: life: at {}, tube depth {depth:.4e} m, the life step that keeps the depth change of contact '{contact}' within life.max_depth_change is {step:.3e} s, below what the service time resolves there (t + Δt = t): the depth grows too fast there to be followed to {} years; raise life.max_depth_change or life.depth_resolution, or shorten life.target_years (results so far written)",
+            when(*time),
+            readable(life.target / YEAR)
         ))),
         LifeEnd::Diverged {
             window,
@@ -128,19 +218,122 @@ pub fn main(
             step,
             contact,
         } => Err(Failure::failed(format!(
-            "{}: life: window {window} (at {:.4} years) diverged at step {step}{}; results so far written",
-            path.display(),
-            time / YEAR,
+            "{source}: life: window {window} (at {}) diverged at step {step}{}; results so far written",
+            when(*time),
             contact
                 .as_ref()
                 .map(|c| format!(", contact '{c}'"))
                 .unwrap_or_default()
         ))),
+        LifeEnd::Stopped { time } => Err(Failure::failed(format!(
+            "{source}: life: interrupted at {}; the results up to then are in {}; continue it with: fretdyn life --resume {}",
+            when(*time),
+            dir.display(),
+            dir.display()
+        ))),
+    };
+    end?;
+    if o.halvings > 0 {
+        convergence(&case, &life, &results, o.halvings, &dir, o.plots)
+            .map_err(|e| Failure::input(e.in_file(&path)))??;
     }
+    Ok(())
+}
+
+/// The case file of the life in `dir` (`life_run.json`), for `--resume`.
+fn recorded_case(dir: &Path) -> Result<PathBuf, Failure> {
+    let run_file = dir.join(LIFE_RUN_FILE);
+    let info: serde_json::Value = std::fs::read_to_string(&run_file)
+        .map_err(|e| e.to_string())
+        .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+        .map_err(|e| {
+            Failure::input(format!(
+                "{}: {e} (--resume needs a folder written by fretdyn life CASE)",
+                run_file.display()
+            ))
+        })?;
+    Ok(PathBuf::from(
+        info["case_file"].as_str().unwrap_or_default(),
+    ))
+}
+
+/// The checkpoint to resume the life in `dir` from: refused when the case (or a file it
+/// reads) changed since the life started, or when there is none.
+fn read_checkpoint(dir: &Path, path: &Path, fingerprint: u64) -> Result<LifeCheckpoint, Failure> {
+    let info: serde_json::Value = std::fs::read_to_string(dir.join(LIFE_RUN_FILE))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    if info["fingerprint"].as_str() != Some(fingerprint.to_string().as_str()) {
+        return Err(Failure::input(format!(
+            "{}: the case file or a file it reads changed since the life in {} started; start the life again instead of resuming it: fretdyn life {} -o {}",
+            path.display(),
+            dir.display(),
+            path.display(),
+            dir.display()
+        )));
+    }
+    let checkpoint = dir.join(CHECKPOINT_FILE);
+    if !checkpoint.exists() {
+        return Err(Failure::input(format!(
+            "{}: no checkpoint to resume: the life there is over (life.json says how it ended) or stopped before its first checkpoint; start it again: fretdyn life {} -o {}",
+            dir.display(),
+            path.display(),
+            dir.display()
+        )));
+    }
+    let c = LifeCheckpoint::read(&checkpoint).map_err(|e| Failure::input(e.to_string()))?;
+    if c.fingerprint() != fingerprint {
+        return Err(Failure::input(format!(
+            "{}: written for other inputs than {} has now; start the life again: fretdyn life {} -o {}",
+            checkpoint.display(),
+            path.display(),
+            path.display(),
+            dir.display()
+        )));
+    }
+    Ok(c)
+}
+
+/// A new life in `dir`: the files of an earlier life there are removed, and the case it
+/// belongs to recorded (`life_run.json`).
+fn start_afresh(dir: &Path, path: &Path, fingerprint: u64) -> Result<(), Failure> {
+    for name in OUTPUTS.iter().chain(&[CHECKPOINT_FILE]) {
+        let p = dir.join(name);
+        match std::fs::remove_file(&p) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(Failure::failed(format!("{}: {e}", p.display())));
+            }
+            _ => {}
+        }
+    }
+    let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let info = serde_json::json!({ "case_file": absolute, "fingerprint": fingerprint.to_string() });
+    fretdyn::files::write_text_atomically(&dir.join(LIFE_RUN_FILE), &format!("{info:#}\n"))
+        .map_err(|e| Failure::failed(e.to_string()))
+}
+
+/// A service time in a message: in years, or in seconds when below a hundredth of a year.
+fn when(t: f64) -> String {
+    if t == 0.0 || t >= 0.01 * YEAR {
+        format!("{:.4} years", t / YEAR)
+    } else {
+        format!("{t:.4e} s")
+    }
+}
+
+/// A number computed from the input as a person would write it: 12 significant digits,
+/// then the shortest form (`0.1 + 0.2` → `0.3`).
+fn readable(x: f64) -> String {
+    let rounded: f64 = format!("{x:.11e}").parse().unwrap_or(x);
+    format!("{rounded}")
 }
 
 /// The life again with `max_depth_change` halved `halvings` times: the tube's depth at the
 /// end of each (`convergence.csv`, `convergence.png`), the convergence check of THEORY §14.5.
+/// Each row says how its life ended and when: a life cut short (a step limit, a divergence, a
+/// scar at its limit) is marked, not taken for one that reached the target, and fails the
+/// command once the table is written. Ctrl-C or SIGTERM stops the refinements (no table).
 fn convergence(
     case: &Case,
     life: &fretdyn::apps::life::LifeSettings,
@@ -150,16 +343,28 @@ fn convergence(
     plots: bool,
 ) -> fretdyn::Result<Result<(), Failure>> {
     let mut fractions = vec![life.max_depth_change];
-    let mut depths: Vec<Vec<f64>> = vec![end_depths(first)];
-    let mut steps = vec![first.steps.len() - 1];
-    for h in 1..=halvings {
+    let mut lives: Vec<LifeResults> = vec![first.clone()];
+    for h in 1..=halvings.min(MAX_HALVINGS) {
         let mut refined = life.clone();
         refined.max_depth_change = life.max_depth_change / f64::from(1u32 << h);
-        let r = service_life(case, &refined, |_| {})?;
+        let mut control = LifeControl {
+            stop: Some(&crate::signals::INTERRUPTED),
+            ..LifeControl::default()
+        };
+        let r = service_life_with(case, &refined, &mut control, |_| {})?;
+        if let LifeEnd::Stopped { time } = r.end {
+            return Ok(Err(Failure::failed(format!(
+                "life: interrupted in the life with max_depth_change = {} at {:.4} years; the life itself is in {}, the convergence check was not written (run it again with --halvings)",
+                refined.max_depth_change,
+                time / YEAR,
+                dir.display()
+            ))));
+        }
         if let Err(e) = outln!(
-            "max_depth_change = {}: {} life steps, tube depth at the end (m) {}",
+            "max_depth_change = {}: {} life steps, {}, tube depth at the end (m) {}",
             refined.max_depth_change,
             r.steps.len() - 1,
+            r.end.name(),
             end_depths(&r)
                 .iter()
                 .map(|d| format!("{d:.4e}"))
@@ -169,30 +374,34 @@ fn convergence(
             return Ok(Err(e));
         }
         fractions.push(refined.max_depth_change);
-        depths.push(end_depths(&r));
-        steps.push(r.steps.len() - 1);
+        lives.push(r);
     }
-    let mut csv = String::from("max_depth_change,life_steps");
+    let mut csv = String::from("max_depth_change,life_steps,life_end,end_years");
     for name in &first.contacts {
         let _ = write!(csv, ",{name}.tube_depth");
     }
     csv.push('\n');
-    for ((f, n), d) in fractions.iter().zip(&steps).zip(&depths) {
-        let _ = write!(csv, "{f:e},{n}");
-        for x in d {
+    for (f, r) in fractions.iter().zip(&lives) {
+        let end = r.steps.last().map_or(0.0, |s| s.time) / YEAR;
+        let _ = write!(csv, "{f:e},{},{},{end:e}", r.steps.len() - 1, r.end.name());
+        for x in end_depths(r) {
             let _ = write!(csv, ",{x:e}");
         }
         csv.push('\n');
     }
     let p = dir.join("convergence.csv");
-    if let Err(e) = std::fs::write(&p, csv) {
-        return Ok(Err(Failure::failed(format!("{}: {e}", p.display()))));
+    if let Err(e) = fretdyn::files::write_text_atomically(&p, &csv) {
+        return Ok(Err(Failure::failed(e.to_string())));
     }
     if plots {
-        // x: the number of halvings, so that the refinements are evenly spaced
-        let x: Vec<f64> = (0..fractions.len()).map(|k| k as f64).collect();
+        // x: the number of halvings, so that the refinements are evenly spaced; only the
+        // lives that reached their end
+        let finished: Vec<usize> = (0..lives.len())
+            .filter(|&k| lives[k].end.is_finished())
+            .collect();
+        let x: Vec<f64> = finished.iter().map(|&k| k as f64).collect();
         let columns: Vec<Vec<f64>> = (0..first.contacts.len())
-            .map(|c| depths.iter().map(|d| d[c]).collect())
+            .map(|c| finished.iter().map(|&k| end_depths(&lives[k])[c]).collect())
             .collect();
         let series: Vec<Series> = first
             .contacts
@@ -216,6 +425,19 @@ fn convergence(
             return Ok(Err(Failure::failed(format!("{}: {e}", png.display()))));
         }
     }
+    let short: Vec<String> = fractions
+        .iter()
+        .zip(&lives)
+        .filter(|(_, r)| !r.end.is_finished())
+        .map(|(f, r)| format!("max_depth_change = {f} ({})", r.end.name()))
+        .collect();
+    if !short.is_empty() {
+        return Ok(Err(Failure::failed(format!(
+            "life: the convergence check is incomplete: {} did not reach the target (marked in {}); their depths are not those at the target",
+            short.join(", "),
+            p.display()
+        ))));
+    }
     Ok(Ok(()))
 }
 
@@ -227,10 +449,12 @@ fn end_depths(r: &LifeResults) -> Vec<f64> {
         .unwrap_or_default()
 }
 
+/// Writes `life.csv`, `scars.csv` and `life.json`, each to a temporary name then renamed
+/// (a full disk never leaves a truncated table under its final name).
 fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Failure> {
     let put = |name: &str, text: String| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).map_err(|e| Failure::failed(format!("{}: {e}", p.display())))
+        fretdyn::files::write_text_atomically(&dir.join(name), &text)
+            .map_err(|e| Failure::failed(e.to_string()))
     };
     let mut csv = String::from("time_years");
     for name in &r.contacts {

@@ -6,6 +6,7 @@
 
 mod against_c;
 mod bench;
+mod folder;
 mod life;
 mod modes;
 mod out;
@@ -13,6 +14,7 @@ mod plot;
 mod progress;
 mod results_plots;
 mod run;
+mod signals;
 mod stability;
 mod sweep;
 mod verify;
@@ -60,8 +62,10 @@ enum Command {
         no_plots: bool,
     },
     /// Run a parametric / Monte-Carlo study (a base case, parameters as a grid or a list,
-    /// seeds) on every core: one row per finished run in DIR/study.csv; run again after a
-    /// crash, the finished runs are skipped.
+    /// seeds) on every core: one row per finished run in DIR/study.csv. Run again after a
+    /// crash or Ctrl-C/SIGTERM (which drop the runs under way), the finished runs are
+    /// skipped — only if the study and its inputs (base case, files it reads) are unchanged:
+    /// a table of other inputs is refused (see --fresh).
     Sweep {
         /// Study file (TOML), see examples/study_clearance.toml.
         #[arg(value_parser = path)]
@@ -72,6 +76,10 @@ enum Command {
         /// Runs at a time [default: one per core].
         #[arg(short, long, default_value_t = 0)]
         jobs: usize,
+        /// Start afresh: replace the table (and the percentiles and plots) of an earlier
+        /// study in the folder instead of continuing it.
+        #[arg(long)]
+        fresh: bool,
         /// No progress bar and no report.
         #[arg(short, long)]
         quiet: bool,
@@ -119,20 +127,31 @@ enum Command {
     },
     /// Service life of a case with a [life] section and contacts with wear (docs/WEAR.md):
     /// windows of vibration, scar growth, the scars fed back into the obstacles, to the
-    /// target time; writes life.csv, life.json, scars.csv and life.png.
+    /// target time; writes life.csv, life.json, scars.csv and life.png. Checkpointed after
+    /// every life step (and inside long windows): Ctrl-C or SIGTERM stops after a
+    /// checkpoint, and --resume DIR continues it.
     Life {
         /// Case file (TOML) with [life] and contacts with `wear`.
-        #[arg(value_parser = path)]
-        case: PathBuf,
+        #[arg(value_parser = path, required_unless_present = "resume")]
+        case: Option<PathBuf>,
+        /// Continue the interrupted (Ctrl-C, SIGTERM, killed) life in this folder from its
+        /// last checkpoint; the results are those of an uninterrupted life.
+        #[arg(long, value_name = "DIR", value_parser = path, conflicts_with = "case")]
+        resume: Option<PathBuf>,
+        /// Wall-clock seconds between checkpoints inside a window of vibration (one is
+        /// written after every life step too).
+        #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
+        checkpoint_every: f64,
         /// Output folder [default: fretdyn_results/<case name>_life].
         #[arg(short, long, value_parser = path)]
         output: Option<PathBuf>,
         /// Do not draw life.png.
         #[arg(long)]
         no_plots: bool,
-        /// Also run the life with max_depth_change halved N times and write the depth at the
-        /// end against it (convergence.csv, convergence.png).
-        #[arg(long, default_value_t = 0)]
+        /// Also run the life with max_depth_change halved N times (at most 10: each halving
+        /// about doubles the life steps) and write the depth at the end against it
+        /// (convergence.csv, convergence.png).
+        #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=life::MAX_HALVINGS as i64))]
         halvings: u32,
     },
     /// Print a shell completion script to standard output, e.g.
@@ -248,6 +267,7 @@ fn command_line_error(e: clap::Error) -> ExitCode {
 }
 
 fn main() -> ExitCode {
+    signals::install();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => return command_line_error(e),
@@ -261,11 +281,6 @@ fn main() -> ExitCode {
             quiet,
             no_plots,
         } => {
-            // Ctrl-C, SIGTERM, SIGHUP: stop at the next progress report, after a checkpoint (a
-            // second signal while stopping is ignored: the files are being closed)
-            let _ = ctrlc::set_handler(|| {
-                run::INTERRUPTED.store(true, std::sync::atomic::Ordering::Relaxed)
-            });
             let options = run::Options {
                 output,
                 quiet,
@@ -284,8 +299,9 @@ fn main() -> ExitCode {
             study,
             output,
             jobs,
+            fresh,
             quiet,
-        } => sweep::main(&study, output, jobs, quiet),
+        } => sweep::main(&study, output, jobs, fresh, quiet),
         Command::Plot { dir } => results_plots::plot_run(&dir).and_then(|files| {
             files
                 .iter()
@@ -305,10 +321,27 @@ fn main() -> ExitCode {
         Command::Stability { case, output } => stability::main(&case, output),
         Command::Life {
             case,
+            resume,
+            checkpoint_every,
             output,
             no_plots,
             halvings,
-        } => life::main(&case, output, !no_plots, halvings),
+        } => {
+            if !(checkpoint_every.is_finite() && checkpoint_every > 0.0) {
+                Err(Failure::input(format!(
+                    "--checkpoint-every: must be a positive number of seconds (got {checkpoint_every})"
+                )))
+            } else {
+                life::main(&life::Options {
+                    case,
+                    resume,
+                    output,
+                    plots: !no_plots,
+                    halvings,
+                    checkpoint_seconds: checkpoint_every,
+                })
+            }
+        }
         Command::Bench {
             steps,
             repeat,

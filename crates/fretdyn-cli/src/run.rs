@@ -7,10 +7,8 @@
 //! results of an uninterrupted run bit for bit. A run holds a lock on its folder: a second
 //! run on the same folder is refused.
 
-use std::fs::File;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
@@ -25,15 +23,8 @@ use crate::out::{errln, outln};
 use crate::plot::{Series, line_plot};
 use crate::progress::Bar;
 
-/// Set by Ctrl-C or SIGTERM: the run stops at its next progress report, after a checkpoint.
-pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
-
 /// The file that records which case a run folder belongs to, for `--resume`.
 const RUN_FILE: &str = "run.json";
-
-/// The file a run holds an advisory lock on (`flock`) while it writes in its folder; the
-/// lock goes with the process, however it ends.
-const LOCK_FILE: &str = ".fretdyn.lock";
 
 /// Options of `fretdyn run`.
 pub struct Options {
@@ -62,10 +53,7 @@ pub fn main(case: Option<&Path>, resume: Option<&Path>, options: &Options) -> Re
             fretdyn::integrator::simulation::Simulation::check(&case.model, &case.settings)
                 .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
             check_disk(&case, path, &dir)?;
-            std::fs::create_dir_all(&dir).map_err(|e| {
-                Failure::failed(format!("{}: cannot create the folder: {e}", dir.display()))
-            })?;
-            let _lock = lock(&dir)?;
+            let _lock = crate::folder::lock(&dir, "run")?;
             let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
             let run_file = json!({ "case_file": absolute, "fingerprint": fingerprint.to_string() });
             std::fs::write(dir.join(RUN_FILE), format!("{run_file:#}\n"))
@@ -104,62 +92,6 @@ fn load(path: &Path) -> Result<Case, Failure> {
         }
     }
     Ok(case)
-}
-
-/// The lock of a run folder, held until dropped.
-pub struct FolderLock {
-    #[cfg(unix)]
-    _lock: nix::fcntl::Flock<File>,
-}
-
-/// Takes the lock of the run folder `dir` (which exists), or refuses: another run writes
-/// there. An advisory `flock` on [`LOCK_FILE`] (std's `File::try_lock` would need Rust 1.89);
-/// elsewhere than on Unix, no lock.
-fn lock(dir: &Path) -> Result<FolderLock, Failure> {
-    let path = dir.join(LOCK_FILE);
-    let io = |e: std::io::Error| Failure::failed(format!("{}: {e}", path.display()));
-    let file = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(&path)
-        .map_err(io)?;
-    #[cfg(unix)]
-    {
-        use nix::fcntl::{Flock, FlockArg};
-        use std::io::{Read, Seek, Write};
-        match Flock::lock(file, FlockArg::LockExclusiveNonblock) {
-            Ok(mut lock) => {
-                // who holds it, for the message of the next one (the lock is what counts)
-                let _ = lock
-                    .set_len(0)
-                    .and_then(|_| lock.rewind())
-                    .and_then(|_| writeln!(*lock, "{}", std::process::id()));
-                Ok(FolderLock { _lock: lock })
-            }
-            Err((mut file, nix::errno::Errno::EWOULDBLOCK)) => {
-                let mut holder = String::new();
-                let _ = file.read_to_string(&mut holder);
-                let holder = holder.trim();
-                Err(Failure::input(format!(
-                    "{}: another fretdyn run{} is writing in this folder; wait for it to end, or give another output folder (-o DIR)",
-                    dir.display(),
-                    if holder.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" (process {holder})")
-                    }
-                )))
-            }
-            Err((_, errno)) => Err(io(errno.into())),
-        }
-    }
-    #[cfg(not(unix))]
-    {
-        drop(file);
-        Ok(FolderLock {})
-    }
 }
 
 /// The time histories a streamed run writes, bytes: its samples (`steps / output.every + 1`)
@@ -294,15 +226,17 @@ fn folder_bytes(dir: &Path) -> u64 {
         .unwrap_or(0)
 }
 
-/// Hash of the case file's text (a resumed run must use the case it started with), and the
+/// The fingerprint of the case file (its values and the content of every file it reads: a
+/// resumed run must use the inputs it started with, [`fretdyn::case::fingerprint`]), and its
 /// text (for `results.nc`).
-fn fingerprint_of(path: &Path) -> Result<(u64, String), Failure> {
-    let bytes =
-        std::fs::read(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
-    Ok((
-        fretdyn::results::stream::fnv1a(&bytes),
-        String::from_utf8_lossy(&bytes).into_owned(),
-    ))
+pub fn fingerprint_of(path: &Path) -> Result<(u64, String), Failure> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+    let value: toml::Value =
+        toml::from_str(&text).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let fingerprint = fretdyn::case::fingerprint::Fingerprint::of(&value, base).value();
+    Ok((fingerprint, text))
 }
 
 fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
@@ -317,7 +251,7 @@ fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
             ))
         })?;
     let path = PathBuf::from(info["case_file"].as_str().unwrap_or_default());
-    let _lock = lock(dir)?;
+    let _lock = crate::folder::lock(dir, "run")?;
     if !dir.join(fretdyn::results::stream::CHECKPOINT_FILE).exists() {
         return Err(Failure::input(format!(
             "{}: the run stopped before its first checkpoint, there is nothing to resume; start it again: fretdyn run {} -o {}",
@@ -330,7 +264,7 @@ fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
     let (fingerprint, text) = fingerprint_of(&path)?;
     if info["fingerprint"].as_str() != Some(fingerprint.to_string().as_str()) {
         return Err(Failure::input(format!(
-            "{}: the case file changed since the run in {} started; start the run again instead of resuming it",
+            "{}: the case file or a file it reads changed since the run in {} started; start the run again instead of resuming it",
             path.display(),
             dir.display()
         )));
@@ -370,7 +304,7 @@ struct Observer<'a> {
 impl StreamObserver for Observer<'_> {
     fn progress(&mut self, p: Progress) -> ControlFlow<()> {
         let _ = self.bar.observe(p);
-        if INTERRUPTED.load(Ordering::Relaxed) {
+        if crate::signals::interrupted() {
             ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
@@ -422,6 +356,7 @@ pub fn run_and_write(
         checkpoint_every_seconds: Some(options.checkpoint_seconds),
         ..StreamSettings::default()
     };
+    let _keeping = crate::signals::Keeping::start();
     let mut observer = Observer {
         bar: Bar::new(&case.title, !options.quiet),
         case,
@@ -666,11 +601,8 @@ fn demo(options: &Options) -> Result<(), Failure> {
         let slug = label.split_whitespace().next().unwrap_or("run").to_string();
         let case = v1.case(&format!("V1a {label}"), method);
         let sub = dir.join(&slug);
-        std::fs::create_dir_all(&sub).map_err(|e| {
-            Failure::failed(format!("{}: cannot create the folder: {e}", sub.display()))
-        })?;
         let fingerprint = fretdyn::results::stream::fnv1a(case.title.as_bytes());
-        let _lock = lock(&sub)?;
+        let _lock = crate::folder::lock(&sub, "run")?;
         run_and_write(&case, "demo", None, &sub, options, fingerprint, false)?;
         let (t, f) = read_friction(&sub)?;
         let magnitude: Vec<f64> = (0..t.len())

@@ -8,20 +8,44 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use fretdyn::apps::percentiles::PercentileReport;
-use fretdyn::apps::study::{CONNORS_COLUMN, Study, connors_exceedance};
+use fretdyn::apps::study::{CONNORS_COLUMN, Study, StudyOptions, connors_exceedance};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Failure;
 use crate::out::{errln, outln};
 use crate::plot::{Series, panels_plot, panels_plot_with_errors};
 
+/// Most runs at a time (`-j`) on a machine of `cores` cores: four per core, and at least
+/// 64 (each is a thread with its own simulation; more only cost their start).
+pub fn max_jobs(cores: usize) -> usize {
+    (4 * cores).max(64)
+}
+
+/// What a study writes in its folder beside its table, from the table: removed before runs
+/// are added (so that a stopped study never leaves the figures of an earlier table) and
+/// written again at its end.
+const DERIVED: [&str; 4] = [
+    "percentiles.csv",
+    "percentiles.json",
+    "percentiles.png",
+    "study.png",
+];
+
 /// Entry point of `fretdyn sweep`.
 pub fn main(
     study: &Path,
     output: Option<PathBuf>,
     jobs: usize,
+    fresh: bool,
     quiet: bool,
 ) -> Result<(), Failure> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if jobs > max_jobs(cores) {
+        return Err(Failure::input(format!(
+            "--jobs {jobs}: at most {} runs at a time on this machine of {cores} cores (0, the default, runs one per core)",
+            max_jobs(cores)
+        )));
+    }
     let s = Study::from_file(study).map_err(|e| Failure::input(e.in_file(study)))?;
     // every run's case is built and checked before anything is run or written
     s.check(jobs)
@@ -33,9 +57,7 @@ pub fn main(
             .unwrap_or_else(|| "study".into());
         PathBuf::from("fretdyn_results").join(stem)
     });
-    std::fs::create_dir_all(&dir).map_err(|e| {
-        Failure::failed(format!("{}: cannot create the folder: {e}", dir.display()))
-    })?;
+    let _lock = crate::folder::lock(&dir, "sweep")?;
     let table = dir.join("study.csv");
     let total = s.runs().len();
     let bar = Mutex::new(None::<ProgressBar>);
@@ -62,10 +84,41 @@ pub fn main(
             bar.finish_and_clear();
         }
     };
-    let done = s
-        .execute_checked(&table, jobs, &progress)
+    let keeping = crate::signals::Keeping::start();
+    let options = StudyOptions {
+        jobs,
+        fresh,
+        stop: Some(&crate::signals::INTERRUPTED),
+    };
+    let mut table_file = s
+        .open_table(&table, options.fresh)
+        .map_err(|e| Failure::input(e.in_file(study)))?;
+    if !table_file.pending().is_empty() {
+        for name in DERIVED {
+            let _ = std::fs::remove_file(dir.join(name));
+        }
+    }
+    let outcome = s
+        .run_on(&mut table_file, &options, &progress)
         .map_err(|e| Failure::failed(e.in_file(study)))?;
+    drop(table_file);
+    drop(keeping);
+    if let Some(b) = bar.lock().unwrap_or_else(|e| e.into_inner()).take() {
+        b.finish_and_clear();
+    }
     let wall = start.elapsed().as_secs_f64();
+    if outcome.stopped {
+        return Err(Failure::failed(format!(
+            "{}: interrupted: {} runs done now, {} of {total} in {} (the runs under way were dropped; no percentiles or plots of an incomplete study); continue it with: fretdyn sweep {} -o {}",
+            study.display(),
+            outcome.done,
+            outcome.already + outcome.done,
+            table.display(),
+            study.display(),
+            dir.display()
+        )));
+    }
+    let done = outcome.done;
     // one line for the whole study, not one per mode per run (docs/FLOW.md)
     if let Some(e) = connors_exceedance(&table).map_err(|e| Failure::failed(e.to_string()))? {
         errln!(

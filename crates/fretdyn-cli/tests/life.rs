@@ -3,6 +3,9 @@
 //! runs of `--halvings`; one-line errors naming the file and the field (exit code 2).
 
 mod common;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
 use common::{Scratch, fretdyn};
 
 /// A mass pressed on a bar (10 N) sliding under it at 1 cm/s, μ = 0.3: `W = 0.03 W`.
@@ -90,11 +93,16 @@ fn a_life_writes_its_depths_against_time_and_converges_under_halvings() {
     assert!(std::fs::metadata(s.0.join("out/life.png")).unwrap().len() > 10_000);
     let conv = std::fs::read_to_string(s.0.join("out/convergence.csv")).unwrap();
     assert_eq!(conv.lines().count(), 3, "{conv}");
+    assert!(conv.starts_with("max_depth_change,life_steps,life_end,end_years,bar.tube_depth\n"));
     // a constant rate: the depth at the end does not depend on the life step
     let ends: Vec<f64> = conv
         .lines()
         .skip(1)
-        .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            assert_eq!((cells[2], cells[3]), ("completed", "1e1"), "{l}");
+            cells[4].parse().unwrap()
+        })
         .collect();
     assert!((ends[0] - ends[1]).abs() < 1e-6 * ends[0]);
     assert!(
@@ -137,4 +145,222 @@ fn life_errors_are_one_line_naming_the_file_and_the_field() {
         assert!(stderr.starts_with("error: bad.toml: "), "{stderr}");
         assert!(stderr.contains(needle), "'{needle}' not in {stderr}");
     }
+}
+
+/// The outputs of a life without its wall-clock time.
+fn outputs(dir: &Path) -> (String, String, serde_json::Value) {
+    let read = |name: &str| std::fs::read_to_string(dir.join(name)).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&read("life.json")).unwrap();
+    json["results"]["wall_time"] = serde_json::Value::Null;
+    (read("life.csv"), read("scars.csv"), json)
+}
+
+/// `fretdyn life` in `cwd` with `args`, started in the background.
+fn spawn_life(args: &[&str], cwd: &Path) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .arg("life")
+        .args(args)
+        .current_dir(cwd)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits until the life writing in `dir` has a checkpoint newer than `after` (it must still
+/// be running).
+fn wait_for_checkpoint(
+    child: &mut std::process::Child,
+    dir: &Path,
+    after: Option<std::time::SystemTime>,
+) {
+    let start = std::time::Instant::now();
+    loop {
+        let m = std::fs::metadata(dir.join("life_checkpoint.bin")).and_then(|m| m.modified());
+        if let Ok(m) = m
+            && after.is_none_or(|a| m > a)
+        {
+            return;
+        }
+        assert!(child.try_wait().unwrap().is_none(), "the life ended first");
+        assert!(start.elapsed().as_secs() < 300, "no checkpoint");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
+/// A life stopped by SIGTERM (it stops after a checkpoint and says how to continue), resumed,
+/// killed by SIGKILL (the last checkpoint, inside a window: `--checkpoint-every` is short),
+/// resumed again to its end, gives the outputs of an uninterrupted life bit for bit. A second
+/// life on the folder while one writes there is refused; a resume after the case changed too.
+#[test]
+fn a_life_killed_and_resumed_is_the_uninterrupted_life() {
+    let s = Scratch::new("resume");
+    // windows of 20 s of 1e-4 s steps (~0.2 s of computing each)
+    let case = CASE.replace("duration = 1.5", "duration = 20.0");
+    std::fs::write(s.0.join("case.toml"), &case).unwrap();
+    let out = fretdyn(&["life", "case.toml", "-o", "whole", "--no-plots"], &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let whole = outputs(&s.0.join("whole"));
+
+    let fast = ["--no-plots", "--checkpoint-every", "0.02"];
+    let mut child = spawn_life(&[&["case.toml", "-o", "cut"][..], &fast].concat(), &s.0);
+    wait_for_checkpoint(&mut child, &s.0.join("cut"), None);
+    // a second life on the same folder, while the first writes there
+    let out = fretdyn(&["life", "case.toml", "-o", "cut", "--no-plots"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("another fretdyn life (process"), "{stderr}");
+    // SIGTERM: stops after a checkpoint, with the way to continue
+    Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("interrupted at") && stderr.contains("fretdyn life --resume cut"),
+        "{stderr}"
+    );
+    // resumed, then killed with SIGKILL after a later checkpoint
+    let before = std::fs::metadata(s.0.join("cut/life_checkpoint.bin"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    let mut child = spawn_life(&[&["--resume", "cut"][..], &fast].concat(), &s.0);
+    wait_for_checkpoint(&mut child, &s.0.join("cut"), Some(before));
+    std::thread::sleep(std::time::Duration::from_millis(30));
+    Command::new("kill")
+        .args(["-9", &child.id().to_string()])
+        .status()
+        .unwrap();
+    child.wait().unwrap();
+    // to the end
+    let out = fretdyn(&[&["life", "--resume", "cut"][..], &fast].concat(), &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("resumed from its checkpoint at"));
+    assert_eq!(outputs(&s.0.join("cut")), whole);
+    // over: nothing left to resume
+    let out = fretdyn(&["life", "--resume", "cut"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("no checkpoint to resume"), "{stderr}");
+
+    // a resume after the case changed is refused
+    let mut child = spawn_life(&[&["case.toml", "-o", "changed"][..], &fast].concat(), &s.0);
+    wait_for_checkpoint(&mut child, &s.0.join("changed"), None);
+    Command::new("kill")
+        .args(["-9", &child.id().to_string()])
+        .status()
+        .unwrap();
+    child.wait().unwrap();
+    std::fs::write(s.0.join("case.toml"), case.replace("mu = 0.3", "mu = 0.4")).unwrap();
+    let out = fretdyn(&["life", "--resume", "changed"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("changed since the life in changed started"),
+        "{stderr}"
+    );
+}
+
+/// `--halvings`: a refined life that does not reach the target (here its life steps exceed
+/// `max_steps`) is marked in `convergence.csv` (`life_end`, the years it reached), not written
+/// as if it had, and the command fails naming it; more than 10 halvings are refused (32 wrapped
+/// the life step to 0 life steps and depth 0).
+#[test]
+fn halvings_mark_the_lives_that_did_not_reach_the_target() {
+    let s = Scratch::new("halvings");
+    std::fs::write(
+        s.0.join("case.toml"),
+        CASE.replace(
+            "criterion_depth = 2e-4",
+            "criterion_depth = 2e-4\nmax_steps = 50",
+        ),
+    )
+    .unwrap();
+    let out = fretdyn(
+        &[
+            "life",
+            "case.toml",
+            "-o",
+            "out",
+            "--no-plots",
+            "--halvings",
+            "1",
+        ],
+        &s.0,
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("the convergence check is incomplete: max_depth_change = 0.1 (step_limit)"),
+        "{stderr}"
+    );
+    let conv = std::fs::read_to_string(s.0.join("out/convergence.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = conv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows[0][2], "completed");
+    assert_eq!((rows[1][1], rows[1][2]), ("50", "step_limit"));
+    assert!(rows[1][3].parse::<f64>().unwrap() < 10.0);
+    for n in ["11", "32"] {
+        let out = fretdyn(&["life", "case.toml", "-o", "out", "--halvings", n], &s.0);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(
+            stderr.contains("--halvings") && stderr.contains("0..=10"),
+            "{stderr}"
+        );
+    }
+}
+
+/// A full disk while the life's tables are written (a file-size limit, `ulimit -f`, as a full
+/// disk: writes fail with EFBIG) never leaves a truncated table under its final name: each
+/// is written to a temporary name, then renamed. `life.json`, the largest, fails here; it
+/// used to be left cut in the middle.
+#[test]
+fn a_full_disk_never_leaves_a_truncated_life_table() {
+    let s = Scratch::new("full");
+    std::fs::write(
+        s.0.join("case.toml"),
+        CASE.replace("max_depth_change = 0.2", "max_depth_change = 0.05"),
+    )
+    .unwrap();
+    // 100 blocks of 512 bytes: life.json of this life is ~78 kB, its checkpoint and life.csv
+    // at most ~31 kB
+    let out = Command::new("sh")
+        .args([
+            "-c",
+            "ulimit -f 100; trap '' XFSZ; exec \"$0\" life case.toml -o out --no-plots",
+            env!("CARGO_BIN_EXE_fretdyn"),
+        ])
+        .current_dir(&s.0)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("life.json"), "{stderr}");
+    for name in ["life.csv", "scars.csv", "life.json"] {
+        let path = s.0.join("out").join(name);
+        if let Ok(text) = std::fs::read_to_string(&path) {
+            match name {
+                "life.json" => {
+                    serde_json::from_str::<serde_json::Value>(&text).expect("complete JSON");
+                }
+                _ => assert!(text.ends_with('\n'), "{name} cut"),
+            }
+        }
+    }
+    assert!(!s.0.join("out/life.json").exists());
 }

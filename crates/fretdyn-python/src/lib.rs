@@ -616,13 +616,82 @@ fn study_row(py: Python<'_>, study: StudySource, index: usize) -> PyResult<Strin
 }
 
 /// Runs a study on this machine, `jobs` runs at a time (0: one per core), into the table
-/// `table` (finished runs already in it are skipped); returns the number of runs done.
+/// `table` (finished runs already in it are skipped, if they are of the study's inputs now:
+/// a stale table is refused; `fresh` replaces it); returns the number of runs done.
 #[pyfunction]
-#[pyo3(signature = (study, table, jobs = 0))]
-fn study_local(py: Python<'_>, study: StudySource, table: PathBuf, jobs: usize) -> PyResult<usize> {
+#[pyo3(signature = (study, table, jobs = 0, fresh = false))]
+fn study_local(
+    py: Python<'_>,
+    study: StudySource,
+    table: PathBuf,
+    jobs: usize,
+    fresh: bool,
+) -> PyResult<usize> {
     let s = study.study()?;
-    py.detach(|| s.execute(&table, jobs, &|_, _| {}))
-        .map_err(err)
+    let options = fretdyn::apps::study::StudyOptions {
+        jobs,
+        fresh,
+        stop: None,
+    };
+    py.detach(|| {
+        s.check(jobs)?;
+        s.run_checked(&table, &options, &|_, _| {})
+    })
+    .map(|outcome| outcome.done)
+    .map_err(err)
+}
+
+/// The table of a study open for appending, locked while it is open (a second study on it
+/// is refused): its rows are checked against the study's inputs when it is opened (a stale
+/// table is refused; `fresh` replaces it), and each row appended is checked to be a pending
+/// run's of the same inputs (a Dask worker with other files is refused).
+#[pyclass(module = "fretdyn._native")]
+struct StudyTable {
+    inner: Option<fretdyn::apps::study::StudyTable>,
+}
+
+#[pymethods]
+impl StudyTable {
+    /// The runs without a row.
+    fn pending(&self) -> PyResult<Vec<usize>> {
+        Ok(self.open()?.pending())
+    }
+
+    /// Appends a row made by `study_row`.
+    fn append(&mut self, row: &str) -> PyResult<()> {
+        self.inner
+            .as_mut()
+            .ok_or_else(|| FretdynError::new_err("the study table is closed"))?
+            .append(row)
+            .map_err(err)
+    }
+
+    /// Lets the lock go.
+    fn close(&mut self) {
+        self.inner = None;
+    }
+}
+
+impl StudyTable {
+    fn open(&self) -> PyResult<&fretdyn::apps::study::StudyTable> {
+        self.inner
+            .as_ref()
+            .ok_or_else(|| FretdynError::new_err("the study table is closed"))
+    }
+}
+
+/// Opens (creates) the table `table` of a study for appending rows made elsewhere (Dask).
+#[pyfunction]
+#[pyo3(signature = (study, table, fresh = false))]
+fn open_study_table(
+    py: Python<'_>,
+    study: StudySource,
+    table: PathBuf,
+    fresh: bool,
+) -> PyResult<StudyTable> {
+    let s = study.study()?;
+    let t = py.detach(|| s.open_table(&table, fresh)).map_err(err)?;
+    Ok(StudyTable { inner: Some(t) })
 }
 
 /// The percentiles of a study's `[percentiles]` (or its defaults for a probabilistic study)
@@ -663,6 +732,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_header, m)?)?;
     m.add_function(wrap_pyfunction!(study_row, m)?)?;
     m.add_function(wrap_pyfunction!(study_local, m)?)?;
+    m.add_class::<StudyTable>()?;
+    m.add_function(wrap_pyfunction!(open_study_table, m)?)?;
     m.add_function(wrap_pyfunction!(study_percentiles, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

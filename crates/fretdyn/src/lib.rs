@@ -62,7 +62,7 @@ pub mod wear;
 pub mod apps;
 
 pub mod error;
-mod files;
+pub mod files;
 mod kernels;
 
 // The README's Rust example is compiled with the doctests.

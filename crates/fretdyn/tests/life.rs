@@ -263,3 +263,125 @@ fn a_probabilistic_study_of_service_lives_gives_each_sample_s_closed_form_depth(
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A fast-wearing contact (an Archard coefficient of 1e-3, a contact at rest on its bar: the
+/// life steps are milliseconds against 40 years) runs: its scar grows step by step until
+/// the tube is worn through its diameter, the limit of the flat scar's geometry. It used to
+/// stop at t = 0 with "the scar reached the limit of its geometry", its first life step
+/// being shorter than 1e-12 × the target.
+#[test]
+fn a_fast_wearing_contact_runs_to_the_limit_of_its_scar() {
+    let fast = ARCHARD.replace("coefficient = 2e-15", "coefficient = 1e-3");
+    let (case, life) = case(&fast, "target_years = 40.0");
+    let r = service_life(&case, &life, |_| {}).unwrap();
+    assert!(r.steps.len() > 20, "{} life steps", r.steps.len());
+    let LifeEnd::ScarLimit { time, message, .. } = &r.end else {
+        panic!("{:?}", r.end)
+    };
+    assert!(*time > 0.0 && message.contains("worn through"), "{message}");
+    // the depth went up to the tube's diameter, the flat scar's largest depth
+    let last = &r.steps[r.steps.len() - 1].contacts[0];
+    assert!(last.tube_depth > 0.99 * 2.0 * R, "{}", last.tube_depth);
+    // and every step kept within its limit, the first ones at the depth resolution
+    for pair in r.steps.windows(2) {
+        let (a, b) = (&pair[0].contacts[0], &pair[1].contacts[0]);
+        let limit = 0.1 * (r.clearances[0] + a.clearance_increase).max(life.depth_resolution);
+        assert!(b.clearance_increase - a.clearance_increase <= limit * (1.0 + 1e-9));
+    }
+}
+
+/// Each way a life ends early has its own end: life steps too small for `max_steps`
+/// (`max_depth_change = 1e-10`) end at the step limit, not at "the limit of the scar's
+/// geometry" (what every one of them used to say).
+#[test]
+fn a_life_that_needs_too_many_steps_ends_at_the_step_limit() {
+    let (case, life) = case(
+        ARCHARD,
+        "target_years = 40.0\nmax_depth_change = 1e-10\nmax_steps = 4",
+    );
+    let r = service_life(&case, &life, |_| {}).unwrap();
+    assert_eq!(r.end, LifeEnd::StepLimit);
+    assert_eq!(r.steps.len(), 5);
+    assert!(r.steps[4].time > r.steps[3].time && r.steps[4].time < YEAR);
+    assert!(!r.end.is_finished());
+}
+
+/// A life stopped from outside (the signal of `fretdyn life`) at any moment — between life
+/// steps or inside a window — and continued from its checkpoint gives the uninterrupted
+/// life, bit for bit; a checkpoint of other inputs is refused.
+#[test]
+fn a_life_stopped_anywhere_and_resumed_is_the_uninterrupted_life() {
+    use fretdyn::apps::life::{LifeCheckpoint, LifeControl, service_life_with};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    // long windows (3 s of 1e-4 s steps: 30 batches each), so that a stop lands inside one
+    let text = sliding_mass(ARCHARD, "target_years = 40.0\nmax_depth_change = 0.2")
+        .replace("duration = 1.5", "duration = 3.0");
+    let case = Case::from_toml_str(&text, Path::new(".")).unwrap();
+    let life = case.life.clone().unwrap();
+    let whole = service_life(&case, &life, |_| {}).unwrap();
+    assert_eq!(whole.end, LifeEnd::Completed);
+
+    let dir = std::env::temp_dir().join(format!("fretdyn_life_resume_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("life_checkpoint.bin");
+    let mut resume = None;
+    let mut stops = 0;
+    let (mut inside, mut between) = (0, 0);
+    let resumed = loop {
+        let stop = AtomicBool::new(false);
+        let mut control = LifeControl {
+            checkpoint: Some(&path),
+            // a checkpoint at every batch of steps: the stop lands after any of them
+            checkpoint_every_seconds: 0.0,
+            fingerprint: 42,
+            resume: resume.take(),
+            stop: Some(&stop),
+        };
+        let mut seen = 0;
+        let r = std::thread::scope(|s| {
+            // stop after a few ms, at a different point each time
+            if stops < 6 {
+                let stop = &stop;
+                s.spawn(move || {
+                    std::thread::sleep(std::time::Duration::from_millis(7 + 13 * stops));
+                    stop.store(true, Ordering::Relaxed);
+                });
+            }
+            service_life_with(&case, &life, &mut control, |_| seen += 1).unwrap()
+        });
+        match r.end {
+            LifeEnd::Stopped { time } => {
+                stops += 1;
+                let c = LifeCheckpoint::read(&path).unwrap();
+                assert_eq!(c.time(), time);
+                if c.inside_window() {
+                    inside += 1;
+                } else {
+                    between += 1;
+                }
+                resume = Some(c);
+            }
+            _ => break r,
+        }
+    };
+    assert!(stops >= 3, "{stops} stops");
+    assert!(
+        inside >= 1,
+        "no stop inside a window ({between} between steps)"
+    );
+    assert_eq!(resumed.end, whole.end);
+    assert_eq!(resumed.steps, whole.steps);
+    assert_eq!(resumed.scars, whole.scars);
+    assert_eq!(resumed.time_to_criterion, whole.time_to_criterion);
+    assert_eq!(resumed.windows, whole.windows);
+
+    // a checkpoint for other inputs
+    let mut control = LifeControl {
+        fingerprint: 43,
+        resume: Some(LifeCheckpoint::read(&path).unwrap()),
+        ..LifeControl::default()
+    };
+    let e = service_life_with(&case, &life, &mut control, |_| {}).unwrap_err();
+    assert!(e.to_string().contains("other inputs"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use fretdyn::apps::study::Study;
+use fretdyn::apps::study::{Study, StudyOptions};
 use fretdyn::integrator::simulation::simulate;
 
 fn write_study(dir: &Path, combine: &str) -> std::path::PathBuf {
@@ -161,4 +161,131 @@ fn every_example_study_checks() {
         studies += 1;
     }
     assert!(studies >= 5, "the examples' studies: {studies}");
+}
+
+/// A study with a table load history read from a file, in its own folder.
+fn write_study_with_file(dir: &Path) -> std::path::PathBuf {
+    write_study(dir, "grid");
+    std::fs::write(dir.join("push.csv"), "0,0\n0.004,1\n").unwrap();
+    let text = std::fs::read_to_string(dir.join("v1a.toml")).unwrap()
+        + "\n[[loads]]\npoint = \"mass\"\nforce = [1.0, 0.0, 0.0]\nhistory = { type = \"table\", file = \"push.csv\" }\n";
+    std::fs::write(dir.join("v1a.toml"), text).unwrap();
+    dir.join("study.toml")
+}
+
+/// A table is tied to the inputs of its rows: after the base case changed (μ of the base
+/// case, not a parameter here), after the content of a file it reads changed, or after a
+/// parameter's values changed, running the study into the same table is refused, saying what
+/// changed and how to start afresh — the old rows are never presented as the new study's
+/// (they were: "0 runs, 4 already in the table"). `fresh` starts afresh.
+#[test]
+fn a_table_of_other_inputs_is_refused_with_what_changed() {
+    let dir = std::env::temp_dir().join(format!("fretdyn-study-stale-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = write_study_with_file(&dir);
+    let table = dir.join("study.csv");
+    let study = Study::from_file(&path).unwrap();
+    assert_eq!(study.execute(&table, 2, &|_, _| {}).unwrap(), 4);
+    // unchanged: nothing to do
+    assert_eq!(study.execute(&table, 2, &|_, _| {}).unwrap(), 0);
+    let refused = |needles: &[&str]| {
+        let study = Study::from_file(&path).unwrap();
+        let e = study
+            .execute(&table, 2, &|_, _| {})
+            .unwrap_err()
+            .to_string();
+        for n in needles {
+            assert!(e.contains(n), "{n:?} not in: {e}");
+        }
+        assert!(!e.contains('\n'), "{e}");
+    };
+    // the base case: its normal stiffness
+    let base = std::fs::read_to_string(dir.join("v1a.toml")).unwrap();
+    std::fs::write(
+        dir.join("v1a.toml"),
+        base.replace("stiffness = 1e6", "stiffness = 2e6"),
+    )
+    .unwrap();
+    refused(&[
+        "4 of its 4 rows",
+        "contacts.0.normal.stiffness: 1000000.0 → 2000000.0",
+        "--fresh",
+    ]);
+    std::fs::write(dir.join("v1a.toml"), &base).unwrap();
+    // the content of the load table the case reads (its name unchanged)
+    std::fs::write(dir.join("push.csv"), "0,0\n0.004,2\n").unwrap();
+    refused(&["the content of push.csv changed"]);
+    std::fs::write(dir.join("push.csv"), "0,0\n0.004,1\n").unwrap();
+    assert_eq!(study.execute(&table, 2, &|_, _| {}).unwrap(), 0);
+    // a parameter's values: run 2 and 3 now have another μ
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(&path, text.replace("[0.1, 0.3]", "[0.1, 0.4]")).unwrap();
+    refused(&[
+        "2 of its 4 rows",
+        "run 2: contacts.*.friction.mu = 0.3 in the table, 0.4 now",
+    ]);
+    // afresh
+    let study = Study::from_file(&path).unwrap();
+    let options = StudyOptions {
+        jobs: 2,
+        fresh: true,
+        stop: None,
+    };
+    let outcome = study.run_checked(&table, &options, &|_, _| {}).unwrap();
+    assert_eq!((outcome.done, outcome.already), (4, 0));
+    assert_eq!(rows(&table).len(), 4);
+    assert!(rows(&table)[2].contains(",0.4,"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// One table, one study at a time: a second open of the table is refused while the first
+/// holds it; a row made elsewhere from other inputs (a Dask worker with another file), or of
+/// a run already in the table, is refused; a table with a run twice (two studies that wrote
+/// it at once) is refused; percentiles need every run's row.
+#[test]
+fn a_table_is_written_by_one_study_and_holds_each_run_once() {
+    let dir = std::env::temp_dir().join(format!("fretdyn-study-lock-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = write_study_with_file(&dir);
+    let text = std::fs::read_to_string(&path).unwrap()
+        + "\n[percentiles]\nstatistics = [\"wear_work_rate\"]\n";
+    std::fs::write(&path, text).unwrap();
+    let study = Study::from_file(&path).unwrap();
+    let table = dir.join("study.csv");
+    let mut open = study.open_table(&table, false).unwrap();
+    let e = study.open_table(&table, false).unwrap_err().to_string();
+    assert!(
+        e.contains("a study (process") && e.contains("is writing this table"),
+        "{e}"
+    );
+    let runs = study.runs();
+    let row = study.run_row(&runs[1]).unwrap();
+    open.append(&row).unwrap();
+    assert_eq!(open.pending(), [0, 2, 3]);
+    // the same run again
+    let e = open.append(&row).unwrap_err().to_string();
+    assert!(e.contains("run 1 has a row already"), "{e}");
+    // a row computed from another load table
+    std::fs::write(dir.join("push.csv"), "0,0\n0.004,3\n").unwrap();
+    let foreign = Study::from_file(&path).unwrap().run_row(&runs[2]).unwrap();
+    std::fs::write(dir.join("push.csv"), "0,0\n0.004,1\n").unwrap();
+    let e = open.append(&foreign).unwrap_err().to_string();
+    assert!(e.contains("run 2 was computed from other inputs"), "{e}");
+    // percentiles of the incomplete table
+    let e = study.percentiles(&table).unwrap_err().to_string();
+    assert!(e.contains("1 of the study's 4 runs"), "{e}");
+    drop(open);
+    assert_eq!(study.execute(&table, 2, &|_, _| {}).unwrap(), 3);
+    assert!(study.percentiles(&table).unwrap().is_some());
+    // a run twice
+    let text = std::fs::read_to_string(&table).unwrap();
+    std::fs::write(&table, format!("{text}{row}\n")).unwrap();
+    let e = study
+        .execute(&table, 2, &|_, _| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("run 1 is in the table twice"), "{e}");
+    let e = study.percentiles(&table).unwrap_err().to_string();
+    assert!(e.contains("run 1 is in the table twice"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -732,18 +732,6 @@ def _study_source(study: Union[PathLike, Mapping[str, Any]], base_dir: Optional[
     return (json.dumps(_plain(study)), folder)
 
 
-def _read_done(table: Path, header: str) -> set:
-    if not table.exists() or table.stat().st_size == 0:
-        return set()
-    text = table.read_text()
-    lines = text.splitlines()
-    if lines[0] != header:
-        raise FretdynError(f"{table}: has another header: it belongs to another study")
-    complete = lines[1:] if text.endswith("\n") else lines[1:-1]
-    n = len(header.split(","))
-    return {int(l.split(",")[0]) for l in complete if len(l.split(",")) == n}
-
-
 def _row(study: Any, index: int) -> str:
     return _native.study_row(study, index)
 
@@ -765,11 +753,17 @@ def sweep(
     client: Any = None,
     jobs: int = 0,
     base_dir: Optional[PathLike] = None,
+    fresh: bool = False,
 ):
     """Runs a study, like ``fretdyn sweep``, and returns its table.
 
     One row per finished run is appended to the CSV `table`; runs already in it are skipped
-    (run it again after a crash). Parameters drawn from distributions (``samples = N``,
+    (run it again after a crash) — only when they were computed from the inputs the study
+    gives them now: each row carries the fingerprint of its run's case as resolved and of
+    the files it reads, and a table with a row of other inputs (the base case, a file or a
+    parameter's values changed since) is refused, saying what changed (``fresh=True``
+    starts afresh). The table is locked while the study writes it: a second study on it is
+    refused. Parameters drawn from distributions (``samples = N``,
     docs/STUDIES.md) take the same values on a cluster as here (each draw is a function of
     the study seed, the sample and the parameter); `percentiles` then gives P50/P95/P99 with
     their errors.
@@ -792,6 +786,8 @@ def sweep(
     base_dir : str or os.PathLike, optional
         For a dict study: the folder its ``base`` path and the case's file names are
         relative to (default: the current folder).
+    fresh : bool, default False
+        Replace an existing `table` instead of continuing it.
 
     Returns
     -------
@@ -804,7 +800,8 @@ def sweep(
     ------
     FretdynError
         A bad study (naming the key, e.g. ``parameters[0].key``), or a run whose values make
-        an invalid case (before any run starts).
+        an invalid case (before any run starts); a `table` of other inputs, or one another
+        study is writing; on Dask, a row a worker computed from other files than here.
 
     Examples
     --------
@@ -816,34 +813,31 @@ def sweep(
     source = _study_source(study, base_dir)
     if table is None:
         with tempfile.TemporaryDirectory(prefix="fretdyn-sweep-") as tmp:
-            return sweep(study, Path(tmp) / "study.csv", client, jobs, base_dir)
+            return sweep(study, Path(tmp) / "study.csv", client, jobs, base_dir, fresh)
     table = Path(table)
     if client is None:
-        done = _native.study_local(source, os.fspath(table), jobs)
+        done = _native.study_local(source, os.fspath(table), jobs, fresh)
     else:
-        done = _sweep_on_dask(source, table, client)
+        done = _sweep_on_dask(source, table, client, fresh)
     out = _frame(table)
     if hasattr(out, "attrs"):
         out.attrs["runs_done"] = done
     return out
 
 
-def _sweep_on_dask(source: Any, table: Path, client: Any) -> int:
+def _sweep_on_dask(source: Any, table: Path, client: Any, fresh: bool) -> int:
     from dask.distributed import as_completed
 
-    header = _native.study_header(source)
-    done = _read_done(table, header)
-    if table.exists() and table.stat().st_size > 0 and not table.read_text().endswith("\n"):
-        text = table.read_text()
-        table.write_text(text[: text.rfind("\n") + 1])
-    pending = [i for i in range(_native.study_runs(source)) if i not in done]
-    with open(table, "a", newline="") as f:
-        if not done and f.tell() == 0:
-            f.write(header + "\n")
+    # the table is checked, locked and appended to by the library, as on this machine: each
+    # row a worker returns is checked to be of this study's inputs here
+    opened = _native.open_study_table(source, os.fspath(table), fresh)
+    try:
+        pending = opened.pending()
         futures = [client.submit(_row, source, i, pure=False) for i in pending]
         for future in as_completed(futures):
-            f.write(future.result() + "\n")
-            f.flush()
+            opened.append(future.result())
+    finally:
+        opened.close()
     return len(pending)
 
 

@@ -21,19 +21,27 @@
 
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-use crate::apps::study::statistics_run;
+use std::ops::ControlFlow;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::apps::study::statistics_run_from;
 use crate::case::Case;
 use crate::contact::scar::{AngularProfile, ObstacleWear};
 use crate::error::{Error, Result};
-use crate::integrator::simulation::Termination;
+use crate::integrator::simulation::{Simulation, Snapshot, Termination};
 use crate::model::Model;
 use crate::results::wear_map::WearMap;
 use crate::wear::{ContactWear, HoleScar, Scar, WearWork};
 
 /// Seconds in a year (365.25 days).
 pub const YEAR: f64 = 365.25 * 86_400.0;
+
+/// Most angular bins of a hole's scar profile (0.1° bins): the wear map holds two numbers
+/// per bin and contact, and a life step spreads each bin's volume over the others.
+pub const MAX_ANGULAR_BINS: usize = 3600;
 
 /// The `[life]` section (THEORY §14.5).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -91,10 +99,13 @@ impl LifeSettings {
                 "must be a depth > 0 in m (e.g. 40 % of the tube wall)",
             ));
         }
-        if self.angular_bins < 4 {
+        if !(4..=MAX_ANGULAR_BINS).contains(&self.angular_bins) {
             return Err(Error::invalid(
                 format!("{field}.angular_bins"),
-                "must be at least 4 (72 = 5° bins by default)",
+                format!(
+                    "must be between 4 and {MAX_ANGULAR_BINS} (0.1° bins), got {}; 72 (5° bins) is the default",
+                    self.angular_bins
+                ),
             ));
         }
         if self.max_steps == 0 {
@@ -108,7 +119,7 @@ impl LifeSettings {
 }
 
 /// One contact at the end of a life step.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ContactLife {
     /// Wear work rate of the window that drove the step (the law's work: friction or
     /// normal), W.
@@ -131,7 +142,7 @@ pub struct ContactLife {
 }
 
 /// The state after one life step.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LifeStep {
     /// Service time at the end of the step, s.
     pub time: f64,
@@ -176,6 +187,46 @@ pub enum LifeEnd {
         /// What the geometry says.
         message: String,
     },
+    /// The life step the depth limit allows is below the resolution of the service time in
+    /// floating point (`t + Δt = t`): the wear is too fast, or the target too far, for the
+    /// life step's limit (`max_depth_change`, `depth_resolution`).
+    StepTooShort {
+        /// The contact whose depth limits the step.
+        contact: String,
+        /// Service time, s.
+        time: f64,
+        /// The life step, s.
+        step: f64,
+        /// The contact's tube depth then, m.
+        depth: f64,
+    },
+    /// Stopped from outside (a signal) at this service time: continued from its checkpoint
+    /// by [`service_life_with`] and [`LifeControl::resume`].
+    Stopped {
+        /// Service time reached, s.
+        time: f64,
+    },
+}
+
+impl LifeEnd {
+    /// The name of the end in a table (`life_end` of a study, `convergence.csv`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            LifeEnd::Completed => "completed",
+            LifeEnd::Perforated { .. } => "perforated",
+            LifeEnd::ScarLimit { .. } => "scar_limit",
+            LifeEnd::Diverged { .. } => "diverged",
+            LifeEnd::StepLimit => "step_limit",
+            LifeEnd::StepTooShort { .. } => "step_too_short",
+            LifeEnd::Stopped { .. } => "stopped",
+        }
+    }
+
+    /// Whether the life reached its end: the target time, or a tube through its wall (the
+    /// depth against time up to then is the answer). Any other end is a life cut short.
+    pub fn is_finished(&self) -> bool {
+        matches!(self, LifeEnd::Completed | LifeEnd::Perforated { .. })
+    }
 }
 
 /// A scar's final state, for the scar profiles.
@@ -216,7 +267,7 @@ pub struct LifeResults {
 }
 
 /// Cumulative wear of one contact, per bin of its [`WearMap`].
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 struct Worn {
     /// Tube volume per bin, m³.
     tube: Vec<f64>,
@@ -346,9 +397,14 @@ fn spread(footprint: &[f64], volumes: &[f64]) -> Vec<f64> {
     shape
 }
 
+/// `e` of a contact's wear (its field `wear.…`) named in the case: `contacts[k].wear.…`
+/// with `field` = `contacts[k].wear`.
 fn at(e: Error, field: &str) -> Error {
     match e {
-        Error::Invalid { field: f, message } => Error::invalid(format!("{field}.{f}"), message),
+        Error::Invalid { field: f, message } => {
+            let f = f.strip_prefix("wear.").unwrap_or(&f);
+            Error::invalid(format!("{field}.{f}"), message)
+        }
         other => other,
     }
 }
@@ -371,24 +427,74 @@ fn obstacle_wear(added: &[f64]) -> ObstacleWear {
 }
 
 /// One window's wear work rate and its split over the bins, per wearing contact.
-#[derive(Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 struct Window {
     rates: Vec<f64>,
     errors: Vec<Option<f64>>,
     fractions: Vec<Vec<f64>>,
 }
 
-/// Runs one window of `model`, tracking where the friction work is done.
+/// How a window ended.
+enum WindowEnd {
+    /// Its rates and their split over the bins.
+    Done(Window),
+    /// Diverged at this step of the window, at this contact.
+    Diverged(u64, Option<String>),
+    /// Stopped from outside at the end of a batch: where it stood.
+    Stopped(WindowProgress),
+}
+
+/// A window under way: its simulation's state and where its wear work was done so far, at
+/// the end of a batch of steps (a checkpoint inside a long window).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct WindowProgress {
+    snapshot: Snapshot,
+    map: WearMap,
+}
+
+/// Runs one window of `model`, tracking where the friction work is done, from its start or
+/// from `progress`; `at_batch(progress)` after each batch of steps before the last may stop
+/// it (`Break`).
 fn window(
     case: &Case,
     model: &Model,
     wearing: &[usize],
     bins: usize,
-) -> Result<std::result::Result<Window, (u64, Option<String>)>> {
-    let (results, map) = statistics_run(model, &case.settings, Some(bins))?;
+    progress: Option<WindowProgress>,
+    at_batch: &mut dyn FnMut(&dyn Fn() -> WindowProgress) -> ControlFlow<()>,
+) -> Result<WindowEnd> {
+    let sim = match progress {
+        None => {
+            let mut sim = Simulation::with_recorder(model, &case.settings, 1)?;
+            sim.track_wear(bins);
+            sim
+        }
+        Some(p) => {
+            let mut sim = Simulation::resume(model, &case.settings, p.snapshot, 1)?;
+            sim.track_wear_from(p.map);
+            sim
+        }
+    };
+    let mut stopped = None;
+    let (results, map) = statistics_run_from(sim, &case.settings, &mut |sim| {
+        let here = || WindowProgress {
+            snapshot: sim.snapshot(),
+            map: sim.wear_map().cloned().expect("tracked"),
+        };
+        match at_batch(&here) {
+            ControlFlow::Continue(()) => ControlFlow::Continue(()),
+            ControlFlow::Break(()) => {
+                stopped = Some(here());
+                ControlFlow::Break(sim.steps_done())
+            }
+        }
+    })?;
+    if let Some(progress) = stopped {
+        return Ok(WindowEnd::Stopped(progress));
+    }
     let map = map.expect("tracked");
     if let Termination::Diverged { step, contact, .. } = results.termination {
-        return Ok(Err((step, contact)));
+        return Ok(WindowEnd::Diverged(step, contact));
     }
     let mut rates = Vec::with_capacity(wearing.len());
     let mut errors = Vec::with_capacity(wearing.len());
@@ -409,7 +515,7 @@ fn window(
             vec![0.0; work.len()]
         });
     }
-    Ok(Ok(Window {
+    Ok(WindowEnd::Done(Window {
         rates,
         errors,
         fractions,
@@ -493,6 +599,26 @@ impl<'a> Track<'a> {
         }
     }
 
+    /// What the track has accumulated, for a checkpoint.
+    fn state(&self) -> TrackState {
+        TrackState {
+            worn: self.worn.clone(),
+            fixed: self.fixed.clone(),
+            criterion: self.criterion,
+            criterion_fixed: self.criterion_fixed,
+            perforation: self.perforation,
+        }
+    }
+
+    /// Takes up what a checkpoint's track had accumulated.
+    fn restore(&mut self, s: &TrackState) {
+        self.worn = s.worn.clone();
+        self.fixed = s.fixed.clone();
+        self.criterion = s.criterion;
+        self.criterion_fixed = s.criterion_fixed;
+        self.perforation = s.perforation;
+    }
+
     fn advance(
         &self,
         from: &Worn,
@@ -508,6 +634,10 @@ impl<'a> Track<'a> {
 
     /// The longest step from `t` (at most `dt`) over which the added clearance grows by no
     /// more than the settings allow (§14.5); beyond the scar's geometry counts as too much.
+    /// Found by bisection on `[0, dt]`; a step below `1e-9 dt` (a fast wear against a long
+    /// life), which that bisection cannot resolve, by halving `dt` down to it, then
+    /// bisection between it and its double. `Err` (inside): no step is short enough — the
+    /// scar is at the limit of its geometry (the error of its smallest step).
     fn longest_step(
         &self,
         rate: f64,
@@ -515,15 +645,16 @@ impl<'a> Track<'a> {
         t: f64,
         dt: f64,
         life: &LifeSettings,
-    ) -> Result<f64> {
+    ) -> Result<std::result::Result<f64, Error>> {
         let now = deepest(&self.worn.depths(self.wear, &self.field)?.added);
         let limit = life.max_depth_change * (self.clearance + now).max(life.depth_resolution);
-        let grown = |h: f64| {
+        let growth = |h: f64| {
             self.advance(&self.worn, rate, fractions, t, t + h)
-                .map_or(f64::INFINITY, |a| deepest(&a.depths.added) - now)
+                .map(|a| deepest(&a.depths.added) - now)
         };
+        let grown = |h: f64| growth(h).unwrap_or(f64::INFINITY);
         if grown(dt) <= limit {
-            return Ok(dt);
+            return Ok(Ok(dt));
         }
         let (mut lo, mut hi) = (0.0, dt);
         for _ in 0..60 {
@@ -534,7 +665,37 @@ impl<'a> Track<'a> {
                 lo = mid;
             }
         }
-        Ok(lo)
+        if lo > 1e-9 * dt {
+            return Ok(Ok(lo));
+        }
+        // halvings down to a step within the limit, then bisection in [h, 2h]
+        let mut h = hi;
+        loop {
+            h *= 0.5;
+            match growth(h) {
+                Ok(g) if g <= limit => break,
+                Err(e) if h <= f64::MIN_POSITIVE => return Ok(Err(e)),
+                _ if h <= f64::MIN_POSITIVE => {
+                    return Ok(Err(Error::invalid(
+                        format!("{}.tube", self.field),
+                        format!(
+                            "the depth grows by more than {limit:e} m in any life step: is the wear rate finite?"
+                        ),
+                    )));
+                }
+                _ => {}
+            }
+        }
+        let (mut lo, mut hi) = (h, 2.0 * h);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if grown(mid) > limit {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Ok(Ok(lo))
     }
 
     /// The time in `[t0, t1]` at which the tube's depth from `from` reaches `level`.
@@ -559,6 +720,148 @@ impl<'a> Track<'a> {
 pub fn service_life(
     case: &Case,
     life: &LifeSettings,
+    observer: impl FnMut(&LifeStep),
+) -> Result<LifeResults> {
+    service_life_with(case, life, &mut LifeControl::default(), observer)
+}
+
+/// How a service life is driven from outside: where its checkpoint goes, a life to
+/// continue, and a stop signal.
+#[derive(Default)]
+pub struct LifeControl<'a> {
+    /// The checkpoint file, written after every life step and, inside a window, every
+    /// `checkpoint_every_seconds` of wall-clock time and when the life is stopped
+    /// ([`LifeCheckpoint`]); `None`: no checkpoint.
+    pub checkpoint: Option<&'a Path>,
+    /// Wall-clock seconds between checkpoints inside a window (0: at every batch of steps).
+    pub checkpoint_every_seconds: f64,
+    /// The fingerprint of the inputs (the case as resolved, the files it reads, the life's
+    /// settings): a checkpoint is resumed only by the inputs it was written for.
+    pub fingerprint: u64,
+    /// A life to continue, read by [`LifeCheckpoint::read`]: the results are those of an
+    /// uninterrupted life, bit for bit (but the wall-clock time).
+    pub resume: Option<LifeCheckpoint>,
+    /// Set from outside (a signal): the life stops at the next batch of steps of its window
+    /// or the next life step, after a checkpoint ([`LifeEnd::Stopped`]).
+    pub stop: Option<&'a AtomicBool>,
+}
+
+/// The state of a service life between two batches of steps, as its checkpoint holds it.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct LifeState {
+    /// Service time reached, s.
+    t: f64,
+    /// Windows simulated (finished).
+    windows: usize,
+    /// The state at t = 0 and after every life step so far.
+    steps: Vec<LifeStep>,
+    /// The first window's rates (the fixed-gap extrapolation).
+    first: Option<Window>,
+    /// Each wearing contact's volumes and the times found so far.
+    tracks: Vec<TrackState>,
+    /// Wall-clock time of the sessions before this one, s.
+    wall_time: f64,
+    /// The window under way, if the checkpoint was taken inside one.
+    window: Option<WindowProgress>,
+}
+
+/// What a wearing contact has accumulated (the part of [`Track`] that changes).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct TrackState {
+    worn: Worn,
+    fixed: Worn,
+    criterion: Option<f64>,
+    criterion_fixed: Option<f64>,
+    perforation: Option<f64>,
+}
+
+/// A service life's checkpoint (`life_checkpoint.bin`): these bytes, then the format
+/// version (u32 little-endian), the length of fretdyn's version (u8) and the version, the
+/// fingerprint of the inputs (u64 little-endian), then the state in CBOR (exact for every
+/// `f64`). A checkpoint of another format or version, or of other inputs, is refused.
+#[derive(Debug, Clone)]
+pub struct LifeCheckpoint {
+    fingerprint: u64,
+    state: LifeState,
+}
+
+/// First bytes of a service life's checkpoint.
+pub const LIFE_CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNL";
+/// Format version of a service life's checkpoint.
+pub const LIFE_CHECKPOINT_FORMAT: u32 = 1;
+
+impl LifeCheckpoint {
+    /// Reads the checkpoint at `path`; the error says why it cannot be resumed.
+    pub fn read(path: &Path) -> Result<Self> {
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let bad = |why: String| Error::invalid("checkpoint", format!("{}: {why}", path.display()));
+        let again = "start the life again";
+        let rest = bytes
+            .strip_prefix(LIFE_CHECKPOINT_MAGIC)
+            .ok_or_else(|| bad(format!("not a service life's checkpoint: {again}")))?;
+        let truncated = || bad(format!("truncated: {again}"));
+        let format = u32::from_le_bytes(
+            rest.get(..4)
+                .and_then(|b| b.try_into().ok())
+                .ok_or_else(truncated)?,
+        );
+        let len = *rest.get(4).ok_or_else(truncated)? as usize;
+        let version = String::from_utf8_lossy(rest.get(5..5 + len).ok_or_else(truncated)?);
+        let ours = env!("CARGO_PKG_VERSION");
+        if format != LIFE_CHECKPOINT_FORMAT || version != ours {
+            return Err(bad(format!(
+                "written by fretdyn {version} (format {format}), this is fretdyn {ours} (format {LIFE_CHECKPOINT_FORMAT}): resume it with fretdyn {version}, or {again}"
+            )));
+        }
+        let fingerprint = u64::from_le_bytes(
+            rest.get(5 + len..13 + len)
+                .and_then(|b| b.try_into().ok())
+                .ok_or_else(truncated)?,
+        );
+        let state: LifeState = ciborium::from_reader(&rest[13 + len..])
+            .map_err(|e| bad(format!("damaged ({e}): {again}")))?;
+        Ok(Self { fingerprint, state })
+    }
+
+    /// The service time the checkpoint reached, s.
+    pub fn time(&self) -> f64 {
+        self.state.t
+    }
+
+    /// The fingerprint of the inputs it was written for.
+    pub fn fingerprint(&self) -> u64 {
+        self.fingerprint
+    }
+
+    /// Whether it was taken inside a window of vibration (else between two life steps).
+    pub fn inside_window(&self) -> bool {
+        self.state.window.is_some()
+    }
+
+    fn write(path: &Path, fingerprint: u64, state: &LifeState) -> Result<()> {
+        let version = env!("CARGO_PKG_VERSION").as_bytes();
+        let mut bytes = Vec::with_capacity(4096);
+        bytes.extend_from_slice(LIFE_CHECKPOINT_MAGIC);
+        bytes.extend_from_slice(&LIFE_CHECKPOINT_FORMAT.to_le_bytes());
+        bytes.push(version.len() as u8);
+        bytes.extend_from_slice(version);
+        bytes.extend_from_slice(&fingerprint.to_le_bytes());
+        ciborium::into_writer(state, &mut bytes)
+            .map_err(|e| Error::io(path, std::io::Error::other(e)))?;
+        crate::files::write_atomically(path, |mut f| {
+            use std::io::Write;
+            f.write_all(&bytes)?;
+            f.sync_data()
+        })
+    }
+}
+
+/// [`service_life`] driven by `control`: checkpoints, a life continued from one, a stop
+/// signal ([`LifeEnd::Stopped`], after a checkpoint).
+pub fn service_life_with(
+    case: &Case,
+    life: &LifeSettings,
+    control: &mut LifeControl,
     mut observer: impl FnMut(&LifeStep),
 ) -> Result<LifeResults> {
     life.validate("life")?;
@@ -575,74 +878,209 @@ pub fn service_life(
         ));
     }
     let wearing: Vec<usize> = tracks.iter().map(|c| c.k).collect();
-    let zero = ContactLife {
-        wear_work_rate: 0.0,
-        wear_work_rate_se: None,
-        tube_volume: 0.0,
-        support_volume: 0.0,
-        tube_depth: 0.0,
-        support_depth: 0.0,
-        clearance_increase: 0.0,
-        tube_depth_fixed_gap: 0.0,
+    let stop_requested = || control.stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let mut state = match control.resume.take() {
+        None => {
+            let zero = ContactLife {
+                wear_work_rate: 0.0,
+                wear_work_rate_se: None,
+                tube_volume: 0.0,
+                support_volume: 0.0,
+                tube_depth: 0.0,
+                support_depth: 0.0,
+                clearance_increase: 0.0,
+                tube_depth_fixed_gap: 0.0,
+            };
+            let steps = vec![LifeStep {
+                time: 0.0,
+                contacts: vec![zero; tracks.len()],
+            }];
+            observer(&steps[0]);
+            LifeState {
+                t: 0.0,
+                windows: 0,
+                steps,
+                first: None,
+                tracks: tracks.iter().map(Track::state).collect(),
+                wall_time: 0.0,
+                window: None,
+            }
+        }
+        Some(checkpoint) => {
+            if checkpoint.fingerprint != control.fingerprint {
+                return Err(Error::invalid(
+                    "checkpoint",
+                    "it was written for other inputs (the case, a file it reads or the [life] settings changed since the life started): start the life again instead of resuming it",
+                ));
+            }
+            let state = checkpoint.state;
+            if state.tracks.len() != tracks.len()
+                || state
+                    .tracks
+                    .iter()
+                    .zip(&tracks)
+                    .any(|(s, t)| s.worn.tube.len() != t.worn.tube.len())
+            {
+                return Err(Error::invalid(
+                    "checkpoint",
+                    "its wearing contacts do not match the case: start the life again",
+                ));
+            }
+            state
+        }
     };
-    let mut steps = vec![LifeStep {
-        time: 0.0,
-        contacts: vec![zero; tracks.len()],
-    }];
-    observer(&steps[0]);
-    let mut first: Option<Window> = None;
+    // the obstacles worn so far (the model is a function of the volumes)
     let mut current = model.clone();
-    let (mut t, mut windows) = (0.0, 0);
+    for (c, s) in tracks.iter_mut().zip(&state.tracks) {
+        c.restore(s);
+        if life.feedback && state.steps.len() > 1 {
+            let added = c.worn.depths(c.wear, &c.field)?.added;
+            current.contacts[c.k].obstacle = model.contacts[c.k]
+                .obstacle
+                .worn(&obstacle_wear(&added), &c.field)?;
+        }
+    }
+    let mut last_checkpoint = Instant::now();
+    let save = |state: &LifeState, start: &Instant| -> Result<()> {
+        match control.checkpoint {
+            Some(path) => {
+                let mut s = state.clone();
+                s.wall_time += start.elapsed().as_secs_f64();
+                LifeCheckpoint::write(path, control.fingerprint, &s)
+            }
+            None => Ok(()),
+        }
+    };
     let mut end = LifeEnd::StepLimit;
-    for _ in 0..life.max_steps {
+    while state.steps.len() <= life.max_steps {
+        let t = state.t;
         if t >= life.target {
             break;
         }
+        if stop_requested() {
+            save(&state, &start)?;
+            end = LifeEnd::Stopped { time: t };
+            break;
+        }
         // the window on the obstacles worn so far (only the first one without feedback)
-        let w = match &first {
+        let w = match &state.first {
             Some(f) if !life.feedback => f.clone(),
             _ => {
-                windows += 1;
-                match window(case, &current, &wearing, life.angular_bins)? {
-                    Ok(w) => w,
-                    Err((step, contact)) => {
+                let progress = state.window.take();
+                let mut failed = None;
+                let outcome = window(
+                    case,
+                    &current,
+                    &wearing,
+                    life.angular_bins,
+                    progress,
+                    &mut |here| {
+                        if stop_requested() {
+                            return ControlFlow::Break(());
+                        }
+                        let every = control.checkpoint_every_seconds;
+                        if control.checkpoint.is_some()
+                            && last_checkpoint.elapsed().as_secs_f64() >= every
+                        {
+                            let mut s = state.clone();
+                            s.window = Some(here());
+                            if let Err(e) = save(&s, &start) {
+                                failed = Some(e);
+                                return ControlFlow::Break(());
+                            }
+                            last_checkpoint = Instant::now();
+                        }
+                        ControlFlow::Continue(())
+                    },
+                )?;
+                if let Some(e) = failed {
+                    return Err(e);
+                }
+                match outcome {
+                    WindowEnd::Done(w) => {
+                        state.windows += 1;
+                        w
+                    }
+                    WindowEnd::Diverged(step, contact) => {
                         end = LifeEnd::Diverged {
-                            window: windows - 1,
+                            window: state.windows,
                             time: t,
                             step,
                             contact,
                         };
+                        state.windows += 1;
+                        break;
+                    }
+                    WindowEnd::Stopped(progress) => {
+                        state.window = Some(progress);
+                        save(&state, &start)?;
+                        end = LifeEnd::Stopped { time: t };
                         break;
                     }
                 }
             }
         };
-        let w0 = first.get_or_insert_with(|| w.clone()).clone();
+        let w0 = state.first.get_or_insert_with(|| w.clone()).clone();
+        // the longest step every contact allows, and the contact that sets it
         let mut dt = life.target - t;
+        let mut limiting = 0;
+        let mut beyond = None;
         for (i, c) in tracks.iter().enumerate() {
-            dt = c.longest_step(w.rates[i], &w.fractions[i], t, dt, life)?;
+            match c.longest_step(w.rates[i], &w.fractions[i], t, dt, life)? {
+                Ok(h) if h < dt => (dt, limiting) = (h, i),
+                Ok(_) => {}
+                Err(e) => {
+                    beyond = Some((i, e));
+                    break;
+                }
+            }
+        }
+        if let Some((i, e)) = beyond {
+            // no step is short enough: the scar is at the limit of its geometry
+            end = LifeEnd::ScarLimit {
+                contact: tracks[i].name.clone(),
+                time: t,
+                message: e.to_string(),
+            };
+            break;
         }
         let t1 = if life.target - t - dt <= 1e-12 * life.target {
             life.target
         } else {
             t + dt
         };
+        if !(t1 > t) {
+            // a step below the resolution of the service time: a scar at the limit of its
+            // geometry if the shortest step there is beyond it
+            let c = &tracks[limiting];
+            let (rate, fractions) = (w.rates[limiting], &w.fractions[limiting]);
+            end = match c.advance(&c.worn, rate, fractions, t, t.next_up()) {
+                Err(e) => LifeEnd::ScarLimit {
+                    contact: c.name.clone(),
+                    time: t,
+                    message: e.to_string(),
+                },
+                Ok(_) => LifeEnd::StepTooShort {
+                    contact: c.name.clone(),
+                    time: t,
+                    step: dt,
+                    depth: deepest(&c.worn.depths(c.wear, &c.field)?.tube),
+                },
+            };
+            break;
+        }
         // every contact's next state, or the first scar beyond its geometry
         let mut next = Vec::with_capacity(tracks.len());
         for (i, c) in tracks.iter().enumerate() {
             let a = c.advance(&c.worn, w.rates[i], &w.fractions[i], t, t1);
             let f = c.advance(&c.fixed, w0.rates[i], &w0.fractions[i], t, t1);
             match (a, f) {
-                (Ok(a), Ok(f)) if t1 - t > 1e-12 * life.target => next.push((a, f)),
-                (a, f) => {
-                    let message = match (a.err(), f.err()) {
-                        (Some(e), _) | (None, Some(e)) => e.to_string(),
-                        _ => "the scar's depth no longer grows within its geometry".into(),
-                    };
+                (Ok(a), Ok(f)) => next.push((a, f)),
+                (Err(e), _) | (_, Err(e)) => {
                     end = LifeEnd::ScarLimit {
                         contact: c.name.clone(),
                         time: t,
-                        message,
+                        message: e.to_string(),
                     };
                     break;
                 }
@@ -651,7 +1089,7 @@ pub fn service_life(
         if next.len() < tracks.len() {
             break;
         }
-        let mut state = Vec::with_capacity(tracks.len());
+        let mut contacts = Vec::with_capacity(tracks.len());
         for (i, (c, (a, f))) in tracks.iter_mut().zip(next).enumerate() {
             let (rate, fractions) = (w.rates[i], &w.fractions[i]);
             let tube = deepest(&a.depths.tube);
@@ -670,7 +1108,7 @@ pub fn service_life(
             {
                 c.perforation = Some(c.reaches(&c.worn, rate, fractions, t, t1, wall)?);
             }
-            state.push(ContactLife {
+            contacts.push(ContactLife {
                 wear_work_rate: rate,
                 wear_work_rate_se: w.errors[i],
                 tube_volume: a.worn.tube.iter().sum(),
@@ -687,12 +1125,10 @@ pub fn service_life(
             }
             (c.worn, c.fixed) = (a.worn, f.worn);
         }
-        t = t1;
-        steps.push(LifeStep {
-            time: t,
-            contacts: state,
-        });
-        observer(steps.last().expect("pushed"));
+        state.t = t1;
+        state.steps.push(LifeStep { time: t1, contacts });
+        state.tracks = tracks.iter().map(Track::state).collect();
+        observer(state.steps.last().expect("pushed"));
         // the first tube through its wall ends the life
         if let Some((name, time)) = tracks
             .iter()
@@ -705,8 +1141,10 @@ pub fn service_life(
             };
             break;
         }
+        save(&state, &start)?;
+        last_checkpoint = Instant::now();
     }
-    if t >= life.target && matches!(end, LifeEnd::StepLimit) {
+    if state.t >= life.target && matches!(end, LifeEnd::StepLimit) {
         end = LifeEnd::Completed;
     }
     let mut scars = Vec::with_capacity(tracks.len());
@@ -726,13 +1164,13 @@ pub fn service_life(
     Ok(LifeResults {
         contacts: tracks.iter().map(|c| c.name.clone()).collect(),
         clearances: tracks.iter().map(|c| c.clearance).collect(),
-        steps,
+        steps: state.steps,
         time_to_criterion: tracks.iter().map(|c| c.criterion).collect(),
         time_to_criterion_fixed_gap: tracks.iter().map(|c| c.criterion_fixed).collect(),
         scars,
         end,
-        windows,
-        wall_time: start.elapsed().as_secs_f64(),
+        windows: state.windows,
+        wall_time: state.wall_time + start.elapsed().as_secs_f64(),
     })
 }
 

@@ -42,17 +42,21 @@
 
 use std::collections::BTreeSet;
 use std::io::Write;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use serde::Deserialize;
 
 use super::percentiles::{PercentileReport, PercentileRequest, percentiles_of_table};
 use super::sampling::{Distribution, Stream};
+use crate::case::fingerprint::{Fingerprint, canonical, differences};
 use crate::case::key_path::{KeyPath, KeyPathError, Missing, Part};
 use crate::case::{Case, check_case_text, parse_error};
 use crate::error::{Error, Result};
+use crate::files::Lock;
 use crate::integrator::simulation::{RunResults, RunSettings, Simulation, Termination};
 use crate::model::Model;
 use crate::results::wear_map::WearMap;
@@ -153,6 +157,10 @@ pub struct Sampling {
     /// The table's parameter columns.
     pub columns: Vec<Column>,
 }
+
+/// Most bootstrap resamples of `[percentiles]` (each sorts the samples of every group and
+/// column once).
+pub const MAX_BOOTSTRAP: i64 = 100_000;
 
 /// Most samples a study may ask for (its runs are listed in memory).
 pub const MAX_SAMPLES: i64 = 100_000;
@@ -480,11 +488,14 @@ impl Study {
 
     /// The percentiles of `[percentiles]` (module [`percentiles`](super::percentiles)) from
     /// the table at `table`, grouped by the values of the `values` parameters; `None` when the
-    /// study asks for none.
+    /// study asks for none. The table must hold every run of the study, each from the inputs
+    /// the study gives it now ([`Self::check_table_complete`]): an incomplete or stale table is
+    /// refused.
     pub fn percentiles(&self, table: &Path) -> Result<Option<PercentileReport>> {
         let Some(spec) = &self.percentiles else {
             return Ok(None);
         };
+        self.check_table_complete(table)?;
         let header = self.header(&self.contact_names());
         let names: Vec<&str> = header.split(',').collect();
         let columns = spec
@@ -590,8 +601,8 @@ impl Study {
         runs
     }
 
-    /// The case of one run.
-    pub fn case(&self, run: &RunSpec) -> Result<Case> {
+    /// The case of one run, as TOML: the base case with the run's values and seed set.
+    pub fn case_value(&self, run: &RunSpec) -> Result<toml::Value> {
         let mut value = self.base.clone();
         for (c, v) in self.columns().iter().zip(&run.values) {
             set_path(&mut value, &c.key, v)
@@ -606,6 +617,18 @@ impl Study {
                 }
             }
         }
+        Ok(value)
+    }
+
+    /// The fingerprint of one run ([`Fingerprint`]: its case as resolved and the content of
+    /// every file it reads), as its row writes it in [`FINGERPRINT_COLUMN`].
+    pub fn fingerprint(&self, run: &RunSpec) -> Result<String> {
+        Ok(Fingerprint::of(&self.case_value(run)?, &self.base_dir).text())
+    }
+
+    /// The case of one run.
+    pub fn case(&self, run: &RunSpec) -> Result<Case> {
+        let value = self.case_value(run)?;
         let text = toml::to_string(&value)
             .map_err(|e| Error::invalid("study", format!("cannot write the case: {e}")))?;
         Case::from_toml_str(&text, &self.base_dir).map_err(|e| match e {
@@ -687,6 +710,7 @@ impl Study {
             }
         }
         cols.push(CONNORS_COLUMN.to_string());
+        cols.push(FINGERPRINT_COLUMN.to_string());
         cols.join(",")
     }
 
@@ -746,7 +770,8 @@ impl Study {
     /// Runs every run not already in the table at `table` (created with its header if
     /// missing), `jobs` at a time (0: one per core), appending one row per run as it
     /// finishes; `progress(done, total)` after each. Returns the number of runs done now.
-    /// Every run is checked first ([`Self::check`]): a bad value runs nothing.
+    /// Every run is checked first ([`Self::check`]): a bad value runs nothing. A table whose
+    /// rows were computed from other inputs is refused ([`Self::open_table`]).
     pub fn execute(
         &self,
         table: &Path,
@@ -764,9 +789,118 @@ impl Study {
         jobs: usize,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<usize> {
+        let options = StudyOptions {
+            jobs,
+            ..StudyOptions::default()
+        };
+        Ok(self.run_checked(table, &options, progress)?.done)
+    }
+
+    /// Runs the runs not already in the table at `table` with `options`, after
+    /// [`Self::check`] passed: the table is opened and locked ([`Self::open_table`]), the
+    /// pending runs run `options.jobs` at a time, one row appended per finished run,
+    /// `progress(done, total)` after each. When `options.stop` is set, no run starts and the
+    /// runs under way stop at their next batch of steps and are dropped whole (no row): the
+    /// table holds finished runs only, and running the study again continues it.
+    pub fn run_checked(
+        &self,
+        table: &Path,
+        options: &StudyOptions,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<StudyOutcome> {
+        let mut table = self.open_table(table, options.fresh)?;
+        self.run_on(&mut table, options, progress)
+    }
+
+    /// The pending runs of `table` (opened by [`Self::open_table`]) with `options`, as
+    /// [`Self::run_checked`] runs them.
+    pub fn run_on(
+        &self,
+        table: &mut StudyTable,
+        options: &StudyOptions,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<StudyOutcome> {
+        let pending = table.pending();
+        let already = table.done();
+        let table = Mutex::new(table);
+        let total = pending.len();
         let runs = self.runs();
+        let finished = std::sync::atomic::AtomicUsize::new(0);
+        let stopped = std::sync::atomic::AtomicBool::new(false);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(options.jobs)
+            .build()
+            .map_err(|e| Error::invalid("jobs", e.to_string()))?;
+        let stop = options.stop;
+        let stop_requested = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+        use rayon::prelude::*;
+        pool.install(|| {
+            pending.par_iter().try_for_each(|&index| -> Result<()> {
+                if stop_requested() {
+                    stopped.store(true, Ordering::Relaxed);
+                    return Ok(());
+                }
+                let Some(row) = self.run_row_until(&runs[index], stop)? else {
+                    stopped.store(true, Ordering::Relaxed);
+                    return Ok(());
+                };
+                table
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .append(&row)?;
+                let n = finished.fetch_add(1, Ordering::Relaxed) + 1;
+                progress(n, total);
+                Ok(())
+            })
+        })?;
+        Ok(StudyOutcome {
+            done: finished.load(Ordering::Relaxed),
+            already,
+            pending: total,
+            stopped: stopped.load(Ordering::Relaxed),
+        })
+    }
+
+    /// Opens the table of this study at `table` for writing, locked for as long as the
+    /// returned [`StudyTable`] lives (a second study writing it is refused, naming the
+    /// process that holds it). A missing or empty table is created with its header, and the
+    /// record of the inputs beside it ([`record_path`]). An existing one is checked row by
+    /// row: each complete row's [`FINGERPRINT_COLUMN`] must be the fingerprint this study
+    /// gives its run now, and no run may appear twice; otherwise the table is refused with
+    /// what changed (the base case's keys, the files it reads, the runs' values) and how to
+    /// start afresh — its rows are never reused. With `fresh`, an existing table (and its
+    /// record) is replaced. A row cut by a crash is dropped (its run is done again).
+    pub fn open_table(&self, table: &Path, fresh: bool) -> Result<StudyTable> {
+        let lock_path = lock_path(table);
+        let lock = match Lock::try_new(&lock_path, "a study")? {
+            Ok(lock) => lock,
+            Err(holder) => {
+                return Err(Error::invalid(
+                    "table",
+                    format!(
+                        "{}: {holder} is writing this table; wait for it to end, or write to another table (-o DIR)",
+                        table.display(),
+                    ),
+                ));
+            }
+        };
+        let runs = self.runs();
+        let expected = runs
+            .iter()
+            .map(|r| self.fingerprint(r))
+            .collect::<Result<Vec<_>>>()?;
         let header = self.header(&self.contact_names());
-        let done = read_done(table, &header)?;
+        if fresh {
+            for path in [table.to_path_buf(), record_path(table)] {
+                match std::fs::remove_file(&path) {
+                    Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                        return Err(Error::io(&path, e));
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let done = self.checked_rows(table, &header, &expected, &runs)?;
         // a row cut by a crash is dropped (its run is done again)
         if let Ok(text) = std::fs::read(table) {
             if !text.is_empty() && !text.ends_with(b"\n") {
@@ -783,39 +917,211 @@ impl Study {
             .append(true)
             .open(table)
             .map_err(|e| Error::io(table, e))?;
-        if done.is_empty() && file.metadata().map(|m| m.len()).unwrap_or(0) == 0 {
-            writeln!(file, "{header}").map_err(|e| Error::io(table, e))?;
+        if file.metadata().map(|m| m.len()).unwrap_or(0) == 0 {
+            crate::files::write_text_atomically(&record_path(table), &self.record())?;
+            writeln!(file, "{header}")
+                .and_then(|_| file.flush())
+                .map_err(|e| Error::io(table, e))?;
         }
-        let pending: Vec<&RunSpec> = runs.iter().filter(|r| !done.contains(&r.index)).collect();
-        let total = pending.len();
-        let file = Mutex::new(file);
-        let finished = std::sync::atomic::AtomicUsize::new(0);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(jobs)
-            .build()
-            .map_err(|e| Error::invalid("jobs", e.to_string()))?;
-        use rayon::prelude::*;
-        pool.install(|| {
-            pending.par_iter().try_for_each(|run| -> Result<()> {
-                let row = self.run_row(run)?;
-                let mut f = file.lock().unwrap_or_else(|e| e.into_inner());
-                writeln!(f, "{row}")
-                    .and_then(|_| f.flush())
-                    .map_err(|e| Error::io(table, e))?;
-                drop(f);
-                let n = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress(n, total);
-                Ok(())
+        Ok(StudyTable {
+            path: table.to_path_buf(),
+            file,
+            _lock: lock,
+            expected,
+            done,
+            columns: header.split(',').count(),
+        })
+    }
+
+    /// The runs with a row in the table at `table` (none when it is missing or empty),
+    /// after checking each complete row against `expected` (the fingerprint of each run): a
+    /// table with a row of other inputs, or a run twice, is refused ([`Self::open_table`]).
+    fn checked_rows(
+        &self,
+        table: &Path,
+        header: &str,
+        expected: &[String],
+        runs: &[RunSpec],
+    ) -> Result<BTreeSet<usize>> {
+        let rows = read_rows(table, header)?;
+        let mut done = BTreeSet::new();
+        let mut stale = Vec::new();
+        for row in &rows {
+            let fits = expected
+                .get(row.index)
+                .is_some_and(|f| *f == row.fingerprint);
+            if !fits {
+                stale.push(row);
+            } else if !done.insert(row.index) {
+                return Err(Error::invalid(
+                    "table",
+                    format!(
+                        "{}: run {} is in the table twice (two studies wrote it at once): its percentiles would count it twice; start afresh with --fresh (Python: fresh=True), or write to another table",
+                        table.display(),
+                        row.index
+                    ),
+                ));
+            }
+        }
+        if !stale.is_empty() {
+            return Err(Error::invalid(
+                "table",
+                format!(
+                    "{}: {} of its {} rows were computed from other inputs than this study gives now ({}); they are not reused: start afresh with --fresh (Python: fresh=True; the table is replaced), or write to another table (-o DIR)",
+                    table.display(),
+                    stale.len(),
+                    rows.len(),
+                    self.what_changed(table, &stale, runs)
+                ),
+            ));
+        }
+        Ok(done)
+    }
+
+    /// Checks that the table at `table` holds a row for every run of this study, each of the
+    /// inputs this study gives it now: the percentiles of an incomplete or stale table would
+    /// look complete and be wrong.
+    pub fn check_table_complete(&self, table: &Path) -> Result<()> {
+        if !table.exists() {
+            return Err(Error::io(
+                table,
+                std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    "no such file: run the study first",
+                ),
+            ));
+        }
+        let runs = self.runs();
+        let expected = runs
+            .iter()
+            .map(|r| self.fingerprint(r))
+            .collect::<Result<Vec<_>>>()?;
+        let done =
+            self.checked_rows(table, &self.header(&self.contact_names()), &expected, &runs)?;
+        if done.len() < runs.len() {
+            return Err(Error::invalid(
+                "table",
+                format!(
+                    "{}: {} of the study's {} runs have a row: the percentiles of an incomplete study would look complete; run the study to its end first (fretdyn sweep, or fretdyn.sweep with the same table)",
+                    table.display(),
+                    done.len(),
+                    runs.len()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The record of the inputs written beside a new table ([`record_path`]): the fretdyn
+    /// version, the base case as resolved (canonical TOML) and the hash of each file it reads
+    /// — what [`Self::open_table`] compares with to say what changed.
+    fn record(&self) -> String {
+        let f = Fingerprint::of(&self.base, &self.base_dir);
+        let files: serde_json::Map<String, serde_json::Value> = f
+            .files
+            .iter()
+            .map(|(name, h)| {
+                (
+                    name.clone(),
+                    h.map_or(serde_json::Value::Null, |h| format!("{h:016x}").into()),
+                )
             })
-        })?;
-        Ok(total)
+            .collect();
+        let json = serde_json::json!({
+            "fretdyn": env!("CARGO_PKG_VERSION"),
+            "base": canonical(&self.base),
+            "files": files,
+        });
+        format!("{json:#}\n")
+    }
+
+    /// What makes `stale` rows differ from this study's runs, for the message of
+    /// [`Self::open_table`]: the base case's keys and files against the record beside the
+    /// table, and the parameter values of the rows against the runs of the same index.
+    fn what_changed(&self, table: &Path, stale: &[&TableRow], runs: &[RunSpec]) -> String {
+        let mut causes = Vec::new();
+        let record: Option<serde_json::Value> = std::fs::read_to_string(record_path(table))
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok());
+        match &record {
+            Some(record) => {
+                let old_base: Option<toml::Value> =
+                    record["base"].as_str().and_then(|t| toml::from_str(t).ok());
+                if let Some(old) = old_base {
+                    let keys = differences(&old, &self.base, 3);
+                    if !keys.is_empty() {
+                        causes.push(format!("the base case changed: {}", keys.join(", ")));
+                    }
+                }
+                let now = Fingerprint::of(&self.base, &self.base_dir);
+                let changed: Vec<&str> = now
+                    .files
+                    .iter()
+                    .filter(|(name, h)| {
+                        let was = record["files"][name.as_str()].as_str();
+                        was != h.map(|h| format!("{h:016x}")).as_deref()
+                    })
+                    .map(|(name, _)| name.as_str())
+                    .collect();
+                if !changed.is_empty() {
+                    causes.push(format!("the content of {} changed", changed.join(", ")));
+                }
+            }
+            None => causes.push(format!(
+                "{} is missing: the inputs of its rows are unknown",
+                record_path(table).display()
+            )),
+        }
+        let columns = self.columns();
+        for row in stale.iter().take(3) {
+            match runs.get(row.index) {
+                None => causes.push(format!(
+                    "the table has run {}, the study now has {} runs",
+                    row.index,
+                    runs.len()
+                )),
+                Some(run) => {
+                    let moved: Vec<String> = columns
+                        .iter()
+                        .zip(&run.values)
+                        .zip(&row.values)
+                        .filter(|((_, v), cell)| csv_value(v) != **cell)
+                        .map(|((c, v), cell)| {
+                            format!("{} = {cell} in the table, {} now", c.key, csv_value(v))
+                        })
+                        .collect();
+                    if !moved.is_empty() {
+                        causes.push(format!("run {}: {}", row.index, moved.join(", ")));
+                    }
+                }
+            }
+        }
+        if causes.is_empty() {
+            causes.push("a file the runs read, or the values of a run, changed".into());
+        }
+        causes.join("; ")
     }
 
     /// Runs one run and formats its row. Only the statistics are kept
     /// ([`run_statistics`]): memory does not grow with the length of the run.
     pub fn run_row(&self, run: &RunSpec) -> Result<String> {
+        self.run_row_until(run, None)
+            .map(|row| row.expect("a run without a stop signal runs to its end"))
+    }
+
+    /// [`Self::run_row`], stopped at the next batch of steps (or life step) once `stop` is
+    /// set: `None` then (a stopped run has no row).
+    pub fn run_row_until(
+        &self,
+        run: &RunSpec,
+        stop: Option<&AtomicBool>,
+    ) -> Result<Option<String>> {
+        let fingerprint = self.fingerprint(run)?;
         let case = self.case(run)?;
-        let r = run_statistics(&case)?;
+        let r = statistics_run_until(&case.model, &case.settings, None, stop)?.0;
+        if matches!(r.termination, Termination::Stopped { .. }) {
+            return Ok(None);
+        }
         let mut cols = vec![run.index.to_string()];
         cols.extend(run.values.iter().map(csv_value));
         if self.sampling.is_some() {
@@ -842,7 +1148,10 @@ impl Study {
             }
         }
         if let Some(life) = &case.life {
-            cols.extend(life_row(&case, life)?);
+            match life_row(&case, life, stop)? {
+                Some(life) => cols.extend(life),
+                None => return Ok(None),
+            }
         }
         cols.push(
             case.stability()
@@ -850,7 +1159,125 @@ impl Study {
                 .map(|x| x.to_string())
                 .unwrap_or_default(),
         );
-        Ok(cols.join(","))
+        cols.push(fingerprint);
+        Ok(Some(cols.join(",")))
+    }
+}
+
+/// Options of [`Study::run_checked`].
+#[derive(Debug, Default, Clone, Copy)]
+pub struct StudyOptions<'a> {
+    /// Runs at a time (0: one per core).
+    pub jobs: usize,
+    /// Replace an existing table (and its record) instead of continuing it.
+    pub fresh: bool,
+    /// Set from outside (a signal): no run starts, the runs under way are dropped.
+    pub stop: Option<&'a AtomicBool>,
+}
+
+/// What [`Study::run_checked`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StudyOutcome {
+    /// Runs finished now (rows appended).
+    pub done: usize,
+    /// Runs already in the table.
+    pub already: usize,
+    /// Runs that were to be done.
+    pub pending: usize,
+    /// Stopped by `stop` before every pending run was done.
+    pub stopped: bool,
+}
+
+/// Column of the study table that ties each row to the inputs it was computed from: the
+/// fingerprint of its run's case as resolved and of the files it reads
+/// ([`Fingerprint::text`]). A row is reused only when it is the fingerprint the study gives
+/// its run now.
+pub const FINGERPRINT_COLUMN: &str = "fingerprint";
+
+/// The record of the inputs of the table at `table`: `study.csv` → `study.csv.inputs.json`.
+pub fn record_path(table: &Path) -> PathBuf {
+    sibling(table, ".inputs.json", "")
+}
+
+/// The lock of the table at `table`: `study.csv` → `.study.csv.lock`, beside it.
+fn lock_path(table: &Path) -> PathBuf {
+    sibling(table, ".lock", ".")
+}
+
+fn sibling(table: &Path, suffix: &str, prefix: &str) -> PathBuf {
+    let name = table.file_name().unwrap_or_default().to_string_lossy();
+    table.with_file_name(format!("{prefix}{name}{suffix}"))
+}
+
+/// The table of a study, open for appending and locked ([`Study::open_table`]).
+#[derive(Debug)]
+pub struct StudyTable {
+    path: PathBuf,
+    file: std::fs::File,
+    _lock: Lock,
+    /// Each run's fingerprint, by index.
+    expected: Vec<String>,
+    /// Runs with a row.
+    done: BTreeSet<usize>,
+    /// Columns of a row.
+    columns: usize,
+}
+
+impl StudyTable {
+    /// The runs without a row, in order.
+    pub fn pending(&self) -> Vec<usize> {
+        (0..self.expected.len())
+            .filter(|i| !self.done.contains(i))
+            .collect()
+    }
+
+    /// Runs with a row.
+    pub fn done(&self) -> usize {
+        self.done.len()
+    }
+
+    /// Appends a run's row (as [`Study::run_row`] formats it), after checking that it is a
+    /// pending run's, with the fingerprint of its inputs here: a row computed elsewhere
+    /// (a Dask worker) from other files than this machine's is refused, as is a run twice.
+    pub fn append(&mut self, row: &str) -> Result<()> {
+        let cells: Vec<&str> = row.split(',').collect();
+        let index = cells.first().and_then(|c| c.parse::<usize>().ok());
+        let fingerprint = cells.last().copied().unwrap_or_default();
+        let refuse = |why: String| {
+            Err(Error::invalid(
+                "table",
+                format!("{}: a row is refused: {why}", self.path.display()),
+            ))
+        };
+        let Some(index) = index.filter(|_| cells.len() == self.columns) else {
+            return refuse(format!(
+                "it is not a row of this study ({} columns, {} expected)",
+                cells.len(),
+                self.columns
+            ));
+        };
+        match self.expected.get(index) {
+            None => {
+                return refuse(format!(
+                    "run {index} is not one of the study's {} runs",
+                    self.expected.len()
+                ));
+            }
+            Some(f) if f != fingerprint => {
+                return refuse(format!(
+                    "run {index} was computed from other inputs ({fingerprint}) than this study gives it here ({f}): the base case or a file it reads differs where it ran (the workers need the same files)"
+                ));
+            }
+            Some(_) if self.done.contains(&index) => {
+                return refuse(format!("run {index} has a row already"));
+            }
+            Some(_) => {}
+        }
+        writeln!(self.file, "{row}")
+            .and_then(|_| self.file.flush())
+            .map_err(|e| Error::io(&self.path, e))?;
+        self.done.insert(index);
+        Ok(())
     }
 }
 
@@ -865,18 +1292,23 @@ pub const LIFE_COLUMNS: [&str; 4] = [
     "time_to_criterion_fixed_gap",
 ];
 
-/// The life columns of one run: how it ended, then [`LIFE_COLUMNS`] per contact.
-fn life_row(case: &Case, life: &crate::apps::life::LifeSettings) -> Result<Vec<String>> {
-    use crate::apps::life::{LifeEnd, YEAR, service_life};
-    let r = service_life(case, life, |_| {})?;
-    let end = match r.end {
-        LifeEnd::Completed => "completed",
-        LifeEnd::Perforated { .. } => "perforated",
-        LifeEnd::ScarLimit { .. } => "scar_limit",
-        LifeEnd::Diverged { .. } => "diverged",
-        LifeEnd::StepLimit => "step_limit",
+/// The life columns of one run: how it ended, then [`LIFE_COLUMNS`] per contact; `None`
+/// when `stop` stopped it.
+fn life_row(
+    case: &Case,
+    life: &crate::apps::life::LifeSettings,
+    stop: Option<&AtomicBool>,
+) -> Result<Option<Vec<String>>> {
+    use crate::apps::life::{LifeControl, LifeEnd, YEAR, service_life_with};
+    let mut control = LifeControl {
+        stop,
+        ..LifeControl::default()
     };
-    let mut cols = vec![end.to_string()];
+    let r = service_life_with(case, life, &mut control, |_| {})?;
+    if matches!(r.end, LifeEnd::Stopped { .. }) {
+        return Ok(None);
+    }
+    let mut cols = vec![r.end.name().to_string()];
     let last = r.steps.last().map(|s| &s.contacts);
     let years = |t: Option<f64>| t.map_or("inf".to_string(), |t| (t / YEAR).to_string());
     for c in &case.model.contacts {
@@ -890,7 +1322,7 @@ fn life_row(case: &Case, life: &crate::apps::life::LifeSettings) -> Result<Vec<S
             _ => cols.extend(std::iter::repeat_n(String::new(), LIFE_COLUMNS.len())),
         }
     }
-    Ok(cols)
+    Ok(Some(cols))
 }
 
 /// The percentiles of the study file at `study` from the table at `table` (a table written by
@@ -963,11 +1395,40 @@ pub fn statistics_run(
     settings: &RunSettings,
     wear_bins: Option<usize>,
 ) -> Result<(RunResults, Option<WearMap>)> {
-    let start = Instant::now();
+    statistics_run_until(model, settings, wear_bins, None)
+}
+
+/// [`statistics_run`] that stops at the end of a batch of steps once `stop` is set
+/// ([`Termination::Stopped`]).
+pub fn statistics_run_until(
+    model: &Model,
+    settings: &RunSettings,
+    wear_bins: Option<usize>,
+    stop: Option<&AtomicBool>,
+) -> Result<(RunResults, Option<WearMap>)> {
     let mut sim = Simulation::with_recorder(model, settings, 1)?;
     if let Some(bins) = wear_bins {
         sim.track_wear(bins);
     }
+    statistics_run_from(sim, settings, &mut |sim| {
+        if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            ControlFlow::Break(sim.steps_done())
+        } else {
+            ControlFlow::Continue(())
+        }
+    })
+}
+
+/// The loop of [`statistics_run`] from a simulation made (or resumed) by the caller:
+/// `at_batch(sim)` after every batch of steps before the last; `Break(step)` stops the run
+/// there ([`Termination::Stopped`]).
+pub fn statistics_run_from(
+    mut sim: Simulation,
+    settings: &RunSettings,
+    at_batch: &mut dyn FnMut(&Simulation) -> ControlFlow<u64>,
+) -> Result<(RunResults, Option<WearMap>)> {
+    let start = Instant::now();
+    let model = sim.model();
     let total = settings.steps;
     let mut termination = Termination::Completed;
     while sim.steps_done() < total {
@@ -983,6 +1444,12 @@ pub fn statistics_run(
             let statistics = sim.statistics_mut();
             statistics.impacts.clear();
             statistics.blocks.clear();
+            if sim.steps_done() < total
+                && let ControlFlow::Break(step) = at_batch(&sim)
+            {
+                termination = Termination::Stopped { step };
+                break;
+            }
         }
     }
     let map = sim.wear_map().cloned();
@@ -996,26 +1463,44 @@ fn csv_value(v: &toml::Value) -> String {
     }
 }
 
-/// Indices of the runs already in the table (rows with every column); checks its header.
-fn read_done(table: &Path, header: &str) -> Result<BTreeSet<usize>> {
+/// A complete row of a study table: its run, its parameter cells and its fingerprint.
+#[derive(Debug)]
+struct TableRow {
+    index: usize,
+    values: Vec<String>,
+    fingerprint: String,
+}
+
+/// The complete rows of the table at `table` (none when it is missing or empty; a last line
+/// without its end of line is cut, not complete); checks its header.
+fn read_rows(table: &Path, header: &str) -> Result<Vec<TableRow>> {
     let Ok(text) = std::fs::read_to_string(table) else {
-        return Ok(BTreeSet::new());
+        return Ok(Vec::new());
     };
     let mut lines = text.lines();
     match lines.next() {
-        None => return Ok(BTreeSet::new()),
+        None => return Ok(Vec::new()),
         Some(h) if h == header => {}
-        Some(_) => {
+        Some(h) => {
+            let why = if h.split(',').all(|c| c != FINGERPRINT_COLUMN) {
+                "it was written without the fingerprints of its runs' inputs (by fretdyn before 0.1.0 of 2026-11-28), so its rows cannot be tied to this study"
+            } else {
+                "its columns are those of another study"
+            };
             return Err(Error::invalid(
                 "table",
                 format!(
-                    "{} has another header: it belongs to another study; give another output",
+                    "{} has another header: {why}; start afresh with --fresh (Python: fresh=True; the table is replaced), or write to another table (-o DIR)",
                     table.display()
                 ),
             ));
         }
     }
     let columns = header.split(',').count();
+    let parameters = header
+        .split(',')
+        .position(|c| c == "seed")
+        .map_or(0, |seed| seed.saturating_sub(1));
     let complete = if text.ends_with('\n') {
         text.lines().count()
     } else {
@@ -1023,8 +1508,20 @@ fn read_done(table: &Path, header: &str) -> Result<BTreeSet<usize>> {
     };
     Ok(lines
         .take(complete.saturating_sub(1))
-        .filter(|l| l.split(',').count() == columns)
-        .filter_map(|l| l.split(',').next()?.parse().ok())
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            if cells.len() != columns {
+                return None;
+            }
+            Some(TableRow {
+                index: cells[0].parse().ok()?,
+                values: cells[1..1 + parameters]
+                    .iter()
+                    .map(|c| c.to_string())
+                    .collect(),
+                fingerprint: cells[columns - 1].to_string(),
+            })
+        })
         .collect())
 }
 
@@ -1136,11 +1633,13 @@ fn percentile_spec(raw: RawPercentiles) -> Result<PercentileSpec> {
     }
     let bootstrap = match raw.bootstrap {
         None => 1000,
-        Some(b) if b >= 2 => b as usize,
+        Some(b) if (2..=MAX_BOOTSTRAP).contains(&b) => b as usize,
         Some(b) => {
             return Err(Error::invalid(
                 "percentiles.bootstrap",
-                format!("must be at least 2 resamples (1000 is usual), got {b}"),
+                format!(
+                    "must be between 2 and {MAX_BOOTSTRAP} resamples (1000 is usual: the standard error's own error falls as 1/√(2B), 2 % at 1000), got {b}"
+                ),
             ));
         }
     };

@@ -18,6 +18,7 @@
 //! and the Python package.
 
 mod contacts;
+pub mod fingerprint;
 mod flow;
 pub mod key_path;
 mod life;

@@ -12,7 +12,7 @@ use crate::model::Model;
 use crate::results::statistics::StepValues;
 
 /// Friction work and normal work per contact and bin, J.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WearMap {
     work: Vec<Vec<f64>>,
     normal_work: Vec<Vec<f64>>,

@@ -382,6 +382,18 @@ impl<'m> Simulation<'m> {
         self.wear_map.as_ref()
     }
 
+    /// Tracks the wear work from now on into `map`, the [`Self::wear_map`] of the same model
+    /// at the snapshot this simulation was resumed from: a checkpoint of a service life's
+    /// window carries the map beside the [`Snapshot`].
+    pub fn track_wear_from(&mut self, map: WearMap) {
+        self.wear_map = Some(map);
+    }
+
+    /// The model simulated.
+    pub fn model(&self) -> &'m Model {
+        self.model
+    }
+
     /// Steps done.
     pub fn steps_done(&self) -> u64 {
         self.step
