@@ -427,3 +427,59 @@ def test_a_probabilistic_service_life_study_on_dask_equals_the_local_study(tmp_p
     assert p_local == fretdyn.percentiles(path, tmp_path / "dask.csv")
     rows = [r for r in p_local["rows"] if r["column"] == "plate2.depth_at_target"]
     assert rows[0]["estimate"] == pytest.approx(np.percentile(depth, 50), rel=1e-12)
+
+
+def v1a_study(tmp_path):
+    """V1a with two durations: a study of two quick runs."""
+    (tmp_path / "v1a.toml").write_text((EXAMPLES / "v1a_oblique_impact.toml").read_text())
+    path = tmp_path / "study.toml"
+    path.write_text(
+        'base = "v1a.toml"\n\n[[parameters]]\nkey = "time.duration"\nvalues = [2e-3, 4e-3]\n'
+        '\n[percentiles]\nstatistics = ["wear_work_rate"]\n'
+    )
+    return path
+
+
+def test_a_study_of_changed_inputs_is_refused_and_fresh_starts_afresh(tmp_path):
+    """The base case edited (μ 0.3 → 0.6) and the study swept again into the same table:
+    refused, saying what changed (it used to return the old rows as the new study's);
+    ``fresh=True`` starts afresh."""
+    path = v1a_study(tmp_path)
+    assert done(fretdyn.sweep(path, tmp_path / "same.csv")) == 2
+    assert done(fretdyn.sweep(path, tmp_path / "same.csv")) == 0
+    base = (tmp_path / "v1a.toml").read_text()
+    (tmp_path / "v1a.toml").write_text(base.replace("mu = 0.3", "mu = 0.6"))
+    with pytest.raises(fretdyn.FretdynError, match=r"contacts\.0\.friction\.mu: 0\.3 → 0\.6"):
+        fretdyn.sweep(path, tmp_path / "same.csv")
+    with pytest.raises(fretdyn.FretdynError, match="other inputs"):
+        fretdyn.percentiles(path, tmp_path / "same.csv")
+    t = fretdyn.sweep(path, tmp_path / "same.csv", fresh=True)
+    assert done(t) == 2
+    assert list(t["fingerprint"].str.startswith("fp")) == [True, True]
+
+
+def test_a_study_table_is_written_by_one_study_and_rows_of_other_inputs_are_refused(tmp_path):
+    """What the Dask path relies on: the table is locked while open (a second study on it is
+    refused), and a row a worker computed from other files than here is refused."""
+    path = v1a_study(tmp_path)
+    source = os.fspath(path)
+    table = os.fspath(tmp_path / "dask.csv")
+    opened = fretdyn._native.open_study_table(source, table)
+    try:
+        with pytest.raises(fretdyn.FretdynError, match="is writing this table"):
+            fretdyn._native.open_study_table(source, table)
+        with pytest.raises(fretdyn.FretdynError, match="is writing this table"):
+            fretdyn.sweep(path, table)
+        assert opened.pending() == [0, 1]
+        opened.append(fretdyn._native.study_row(source, 0))
+        # a worker whose base case differs
+        base = (tmp_path / "v1a.toml").read_text()
+        (tmp_path / "v1a.toml").write_text(base.replace("mu = 0.3", "mu = 0.6"))
+        foreign = fretdyn._native.study_row(source, 1)
+        (tmp_path / "v1a.toml").write_text(base)
+        with pytest.raises(fretdyn.FretdynError, match="run 1 was computed from other inputs"):
+            opened.append(foreign)
+        assert opened.pending() == [1]
+    finally:
+        opened.close()
+    assert done(fretdyn.sweep(path, table)) == 1
