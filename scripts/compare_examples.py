@@ -7,7 +7,7 @@ For each `examples/*.toml` case: `fretdyn run CASE -o DIR --quiet --no-plots` wi
 then every array of `results.npz` must be identical (same shape, dtype and bits; NaN equal to
 NaN), and `summary.json` identical but for what measures the machine (wall time, steps/s). For
 each study file (`base = ...`): `fretdyn sweep` with both, and `study.csv` identical but for its
-wall-time and steps/s columns. Prints one line per example and exits 1 if any differs.
+wall-time and steps/s columns (and the fingerprint of its inputs). Prints one line per example and exits 1 if any differs.
 
 With `--rtol X`, a change that alters round-off only (a different summation order) is measured
 instead: each example prints the largest relative difference of its arrays (max |Δ| / max |x| of
@@ -31,6 +31,8 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 MACHINE_KEYS = {"wall_time_s", "steps_per_second", "wall_time", "performance"}
+# the fingerprint of a study row's inputs (from [3.1]; absent from older tables): not a result
+INPUT_KEYS = {"fingerprint"}
 
 
 def strip_machine(value):
@@ -149,7 +151,7 @@ def main():
             for d in dirs:
                 with open(d / "study.csv", newline="") as f:
                     rows.append([{k: v for k, v in r.items()
-                                  if "wall" not in k and k not in MACHINE_KEYS}
+                                  if "wall" not in k and k not in MACHINE_KEYS | INPUT_KEYS}
                                  for r in csv.DictReader(f)])
             rows = [sorted(r, key=lambda x: json.dumps(x, sort_keys=True)) for r in rows]
             diff = None if rows[0] == rows[1] else "study.csv differs"
