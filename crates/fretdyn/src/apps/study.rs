@@ -52,7 +52,7 @@ use serde::Deserialize;
 
 use super::percentiles::{PercentileReport, PercentileRequest, percentiles_of_table};
 use super::sampling::{Distribution, Stream};
-use crate::case::fingerprint::{Fingerprint, canonical, differences};
+use crate::case::fingerprint::{FileHashes, Fingerprint, canonical, differences};
 use crate::case::key_path::{KeyPath, KeyPathError, Missing, Part};
 use crate::case::{Case, check_case_text, parse_error};
 use crate::error::{Error, Result};
@@ -626,6 +626,17 @@ impl Study {
         Ok(Fingerprint::of(&self.case_value(run)?, &self.base_dir).text())
     }
 
+    /// The fingerprint of every run, in order, each file read once.
+    fn fingerprints(&self, runs: &[RunSpec]) -> Result<Vec<String>> {
+        let mut cache = FileHashes::default();
+        runs.iter()
+            .map(|r| {
+                let value = self.case_value(r)?;
+                Ok(Fingerprint::of_cached(&value, &self.base_dir, &mut cache).text())
+            })
+            .collect()
+    }
+
     /// The case of one run.
     pub fn case(&self, run: &RunSpec) -> Result<Case> {
         let value = self.case_value(run)?;
@@ -885,10 +896,7 @@ impl Study {
             }
         };
         let runs = self.runs();
-        let expected = runs
-            .iter()
-            .map(|r| self.fingerprint(r))
-            .collect::<Result<Vec<_>>>()?;
+        let expected = self.fingerprints(&runs)?;
         let header = self.header(&self.contact_names());
         if fresh {
             for path in [table.to_path_buf(), record_path(table)] {
@@ -992,10 +1000,7 @@ impl Study {
             ));
         }
         let runs = self.runs();
-        let expected = runs
-            .iter()
-            .map(|r| self.fingerprint(r))
-            .collect::<Result<Vec<_>>>()?;
+        let expected = self.fingerprints(&runs)?;
         let done =
             self.checked_rows(table, &self.header(&self.contact_names()), &expected, &runs)?;
         if done.len() < runs.len() {

@@ -11,6 +11,10 @@
 
 use std::path::Path;
 
+/// The hashes of files read once ([`Fingerprint::of_cached`]).
+#[derive(Debug, Default)]
+pub struct FileHashes(std::collections::HashMap<std::path::PathBuf, Option<u64>>);
+
 /// A case's fingerprint, with its parts (to say which changed).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Fingerprint {
@@ -24,11 +28,21 @@ pub struct Fingerprint {
 impl Fingerprint {
     /// The fingerprint of a case given as TOML; `base` resolves its relative file names.
     pub fn of(case: &toml::Value, base: &Path) -> Self {
+        Self::of_cached(case, base, &mut FileHashes::default())
+    }
+
+    /// [`Self::of`] with the files' hashes kept in `cache` (the runs of a study read the
+    /// same files: each is read once).
+    pub fn of_cached(case: &toml::Value, base: &Path, cache: &mut FileHashes) -> Self {
         let text = canonical(case);
         let files = file_names(case)
             .into_iter()
             .map(|name| {
-                let hash = std::fs::read(base.join(&name)).ok().map(|b| hash(&b));
+                let path = base.join(&name);
+                let hash = *cache
+                    .0
+                    .entry(path)
+                    .or_insert_with_key(|p| std::fs::read(p).ok().map(|b| hash(&b)));
                 (name, hash)
             })
             .collect();
