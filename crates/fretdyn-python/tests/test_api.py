@@ -601,6 +601,36 @@ def test_a_probabilistic_dict_study_gives_its_percentiles(tmp_path):
     assert row["estimate"] == pytest.approx(np.percentile(t["plane.wear_work_rate"], 50), rel=1e-12)
 
 
+def test_what_one_sample_cannot_give_is_an_empty_cell_and_null(tmp_path):
+    # one sample: no interval, no bootstrap error. percentiles.csv wrote NaN where
+    # percentiles.json has null; the study table's convention is an empty cell
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    study = {
+        "base": case, "samples": 1, "seed": 2,
+        "parameters": [{"key": "contacts[0].friction.mu",
+                        "distribution": {"type": "uniform", "low": 0.1, "high": 0.5}}],
+        "percentiles": {"statistics": ["wear_work_rate"]},
+    }
+    fretdyn.sweep(study, tmp_path / "study.csv")
+    p = fretdyn.percentiles(study, tmp_path / "study.csv", output=tmp_path)
+    text = (tmp_path / "percentiles.csv").read_text()
+    assert "nan" not in text.lower(), text
+    assert json.loads((tmp_path / "percentiles.json").read_text()) == p
+    table = fretdyn.read_table(tmp_path / "percentiles.csv")
+    numbers = ["estimate", "ci_low", "ci_high", "ci_coverage", "bootstrap_se"]
+    assert [r["level"] for r in p["rows"]] == [50, 95, 99]
+    for i, row in enumerate(p["rows"]):
+        assert row["n"] == 1 and row["ci_high"] is None and row["bootstrap_se"] is None
+        for k in numbers:
+            # NaN read back exactly where the JSON has null
+            assert np.isnan(table[k][i]) == (row[k] is None), (k, row)
+            if row[k] is not None:
+                assert table[k][i] == row[k]
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(tmp_path / "percentiles.csv")
+    assert frame["bootstrap_se"].isna().all() and frame["estimate"].notna().all()
+
+
 def test_errors_of_a_dict_study_name_the_key():
     case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
     cases = [

@@ -963,7 +963,9 @@ def percentiles(
     table : str or os.PathLike
         Its table.
     output : str or os.PathLike, optional
-        A folder to write ``percentiles.csv`` and ``percentiles.json`` into.
+        A folder to write ``percentiles.csv`` and ``percentiles.json`` into. A value the
+        samples cannot give is an empty cell of ``percentiles.csv``, as in the study table
+        (`read_table` and pandas read NaN), and ``null`` in ``percentiles.json``.
     base_dir : str or os.PathLike, optional
         For a dict study, as in `sweep`.
 
@@ -972,9 +974,10 @@ def percentiles(
     dict or None
         ``{"confidence", "bootstrap_resamples", "seed", "rows": [{"group", "column",
         "level", "n", "excluded", "estimate", "ci_low", "ci_high", "ci_coverage",
-        "bootstrap_se"}, ...]}`` (P50, P95, P99 by default; ``None`` for a bound too few
-        samples give); ``None`` when the study asks for no percentiles (no ``samples``, no
-        ``[percentiles]``).
+        "bootstrap_se"}, ...]}`` (P50, P95, P99 by default; ``None`` for what too few
+        samples cannot give: a bound, the bootstrap error of fewer than 2 values, the
+        estimate of none); ``None`` when the study asks for no percentiles (no ``samples``,
+        no ``[percentiles]``).
 
     Examples
     --------
@@ -994,7 +997,8 @@ def read_table(table: PathLike) -> dict:
     Parameters
     ----------
     table : str or os.PathLike
-        A CSV table written by `sweep` or ``fretdyn sweep``.
+        A CSV table written by `sweep` or ``fretdyn sweep`` (``study.csv``, or its
+        ``percentiles.csv``).
 
     Returns
     -------
