@@ -160,3 +160,30 @@ def test_contacts_csv_opens_in_numpy_with_the_summary_numbers(tmp_path):
     aster = {c["column"]: c["code_aster"] for c in columns}
     assert aster["normal_wear_work_rate"] == "PUIS_USURE (PUIS_USURE)"
     assert aster["impacts_per_second"] == "NB_CHOC_S (STAT_CHOC)"
+
+
+def test_percentiles_of_one_sample_open_in_numpy_with_the_json_nulls(tmp_path):
+    """A study of 1 sample: what one sample cannot give (the upper bounds, the bootstrap
+    errors) is an empty cell of percentiles.csv, as in study.csv (it was NaN), read as NaN by
+    numpy, at the places where percentiles.json has null."""
+    (tmp_path / "case.toml").write_text((ROOT / "examples" / "v1a_oblique_impact.toml").read_text())
+    (tmp_path / "study.toml").write_text(
+        'base = "case.toml"\nsamples = 1\nseed = 4\n\n[[parameters]]\n'
+        'key = "contacts.*.friction.mu"\n'
+        'distribution = { type = "uniform", low = 0.1, high = 0.5 }\n'
+    )
+    p = run(["sweep", "study.toml", "-o", "out", "-q"], tmp_path)
+    assert p.returncode == 0, p.stderr
+    text = (tmp_path / "out" / "percentiles.csv").read_text()
+    assert "nan" not in text.lower(), text
+    # dtype=float: with dtype=None numpy guesses bool for a column of empty cells only
+    table = np.genfromtxt(tmp_path / "out" / "percentiles.csv", delimiter=",", names=True,
+                          dtype=float)
+    rows = json.loads((tmp_path / "out" / "percentiles.json").read_text())["rows"]
+    assert len(table) == len(rows) == 3  # P50, P95, P99 of the one contact
+    for line, row in zip(table, rows):
+        assert row["n"] == 1 and row["ci_high"] is None and row["bootstrap_se"] is None
+        for k in ("estimate", "ci_low", "ci_high", "ci_coverage", "bootstrap_se"):
+            assert np.isnan(line[k]) == (row[k] is None), (k, row)
+            if row[k] is not None:
+                assert line[k] == row[k], k

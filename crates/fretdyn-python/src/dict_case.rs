@@ -2,25 +2,33 @@
 //! case parser, keeping the key path of every line, so that a parse error at a line of that
 //! text is reported by the key path of the dict (`time.dt`, `contacts[0].normal.stiffness`)
 //! instead of a position in a text the user never saw.
+//!
+//! A line refers to its table in the dict (no copy): the memory is the dict's and the text's.
+//! A dict nested deeper than a key path can go ([`MAX_PARTS`]) is refused, naming the path
+//! where it goes deeper, before any text is written: each table's header names its whole
+//! path, so that the text of a chain of tables grows as the square of its depth.
 
+use fretdyn::case::key_path::{MAX_PARTS, abbreviated};
 use serde_json::{Map, Value};
 
 /// What a line of the TOML text holds: the key path, and the table it opens (a header `[a.b]`,
 /// `[[a]]`, or the first line, for the root) if it does rather than hold a `key = value`.
-struct Line {
+struct Line<'a> {
     path: String,
-    table: Option<Map<String, Value>>,
+    table: Option<&'a Map<String, Value>>,
 }
 
 /// The TOML text of a dict and what each of its lines holds.
-pub struct Document {
+pub struct Document<'a> {
     pub text: String,
-    lines: Vec<Line>,
+    lines: Vec<Line<'a>>,
 }
 
-impl Document {
-    /// Writes the dict `root`; an error names the key path of a value TOML cannot hold.
-    pub fn from_json(root: &Map<String, Value>) -> Result<Self, String> {
+impl<'a> Document<'a> {
+    /// Writes the dict `root`; an error names the key path of a value TOML cannot hold, or of
+    /// a value nested deeper than [`MAX_PARTS`] keys and indices.
+    pub fn from_json(root: &'a Map<String, Value>) -> Result<Self, String> {
+        deep(root, "", 0)?;
         let mut doc = Document {
             text: String::new(),
             lines: Vec::new(),
@@ -28,25 +36,26 @@ impl Document {
         doc.push(
             "# a case from a Python dict".into(),
             String::new(),
-            Some(root.clone()),
+            Some(root),
         );
-        doc.table(root, "", &[])?;
+        doc.table(root, "", &mut Vec::new())?;
         Ok(doc)
     }
 
-    fn push(&mut self, text: String, path: String, table: Option<Map<String, Value>>) {
+    fn push(&mut self, text: String, path: String, table: Option<&'a Map<String, Value>>) {
         self.text.push_str(&text);
         self.text.push('\n');
         self.lines.push(Line { path, table });
     }
 
     /// The entries of a table: its values, then its tables and arrays of tables (whose
-    /// headers, `header.key`, are absolute as TOML wants).
+    /// headers, `header.key`, are absolute as TOML wants; `header` is the table's, as it is
+    /// when this returns).
     fn table(
         &mut self,
-        map: &Map<String, Value>,
+        map: &'a Map<String, Value>,
         path: &str,
-        header: &[String],
+        header: &mut Vec<String>,
     ) -> Result<(), String> {
         for (k, v) in map {
             if !is_table(v) && !is_table_array(v) {
@@ -57,20 +66,20 @@ impl Document {
         }
         for (k, v) in map {
             let p = join(path, k);
-            let mut h = header.to_vec();
-            h.push(key(k));
+            header.push(key(k));
             if let Value::Object(m) = v {
-                self.push(format!("[{}]", h.join(".")), p.clone(), Some(m.clone()));
-                self.table(m, &p, &h)?;
+                self.push(format!("[{}]", header.join(".")), p.clone(), Some(m));
+                self.table(m, &p, header)?;
             } else if let (true, Value::Array(items)) = (is_table_array(v), v) {
                 for (i, item) in items.iter().enumerate() {
                     let pi = format!("{p}[{i}]");
                     if let Value::Object(m) = item {
-                        self.push(format!("[[{}]]", h.join(".")), pi.clone(), Some(m.clone()));
-                        self.table(m, &pi, &h)?;
+                        self.push(format!("[[{}]]", header.join(".")), pi.clone(), Some(m));
+                        self.table(m, &pi, header)?;
                     }
                 }
             }
+            header.pop();
         }
         Ok(())
     }
@@ -78,26 +87,42 @@ impl Document {
     /// The key path of the dict for a parse error at `line` (1-based) with `message`: the
     /// path the line holds. An error reported at a table (a tagged table such as an obstacle
     /// is read whole) is narrowed to the key: for a missing or unknown field, the table's path
-    /// and the field (the table's path alone when the unknown field is the table itself); for
+    /// and the field (the table's path alone when the unknown field is the table itself:
+    /// one of its name without other keys among those the message expects); for
     /// a value of the wrong type, the one value of the table shown as the message shows it
     /// (`string "big"`), when only one is.
     pub fn path_at(&self, line: usize, message: &str) -> Option<String> {
         let held = self.lines.get(line.checked_sub(1)?)?;
-        let Some(table) = &held.table else {
+        let Some(table) = held.table else {
             return Some(held.path.clone());
         };
-        let field = ["missing field `", "unknown field `"]
-            .iter()
-            .find_map(|p| message.strip_prefix(p))
-            .and_then(|rest| rest.split('`').next());
-        if let Some(f) = field {
-            // a table the case does not have is reported at its own header
+        let field = |prefix: &str| {
+            message
+                .strip_prefix(prefix)
+                .and_then(|rest| rest.split('`').next())
+        };
+        if let Some(f) = field("unknown field `") {
+            // a table the case does not have is reported at its own header; so is an unknown
+            // key of a table read whole (a tagged table, the obstacle): the table's path alone
+            // for a table of that name, unless the table has other keys among those expected
+            // (`[time.a]` holding a table `a`: the unknown `time.a`; `obstacle` holding a key
+            // `obstacle` beside `gap`: `….obstacle.obstacle`)
             let own = held.path.rsplit(['.', ']']).next() == Some(f);
-            return Some(if own && !table.contains_key(f) {
+            let expected: Vec<&str> = message
+                .split_once(", expected")
+                .map(|(_, list)| list.split('`').skip(1).step_by(2).collect())
+                .unwrap_or_default();
+            let inside = table
+                .keys()
+                .any(|k| k != f && expected.contains(&k.as_str()));
+            return Some(if own && !inside {
                 held.path.clone()
             } else {
                 join(&held.path, f)
             });
+        }
+        if let Some(f) = field("missing field `") {
+            return Some(join(&held.path, f));
         }
         let unexpected = ["invalid type: ", "invalid value: "]
             .iter()
@@ -115,6 +140,37 @@ impl Document {
             _ if held.path.is_empty() => None,
             _ => Some(held.path.clone()),
         }
+    }
+}
+
+/// Refuses a value of `map` (at `path`, `depth` keys and indices below the root) whose key
+/// path has more than [`MAX_PARTS`] parts, naming that path ([`abbreviated`] when long).
+fn deep(map: &Map<String, Value>, path: &str, depth: usize) -> Result<(), String> {
+    for (k, v) in map {
+        within(v, &join(path, k), depth + 1)?;
+    }
+    Ok(())
+}
+
+fn within(v: &Value, path: &str, depth: usize) -> Result<(), String> {
+    if depth > MAX_PARTS {
+        return Err(format!(
+            "{}: nested more than {MAX_PARTS} keys and indices deep: no key of a case is that deep (a key path has at most {MAX_PARTS} parts)",
+            abbreviated(path)
+        ));
+    }
+    match v {
+        Value::Object(m) => deep(m, path, depth),
+        Value::Array(items) => {
+            for (i, item) in items.iter().enumerate() {
+                // an element's path has one part more: numbers are checked at the first
+                if i == 0 || item.is_object() || item.is_array() {
+                    within(item, &format!("{path}[{i}]"), depth + 1)?;
+                }
+            }
+            Ok(())
+        }
+        _ => Ok(()),
     }
 }
 

@@ -179,15 +179,37 @@ fn json_object(json: &str, what: &str) -> PyResult<serde_json::Map<String, serde
 /// An error of the parser of the TOML text `doc` was written to, named by the key path of
 /// the dict (the other errors name their field already).
 fn dict_error(doc: &Document, e: fretdyn::Error) -> PyErr {
+    let (path, message) = dict_error_at(doc, e);
+    FretdynError::new_err(match path {
+        Some(path) => format!("{path}: {message}"),
+        None => message,
+    })
+}
+
+/// The key path of the dict an error of the case read from `doc` is at (a parse error's,
+/// found from its line; a check's field), and the rest of its message; no path for an error
+/// at none.
+fn dict_error_at(doc: &Document, e: fretdyn::Error) -> (Option<String>, String) {
     match e {
-        fretdyn::Error::Parse { line, message, .. } => {
-            FretdynError::new_err(match doc.path_at(line, &message) {
-                Some(path) => format!("{path}: {message}"),
-                None => message,
-            })
-        }
-        other => err(other),
+        fretdyn::Error::Parse { line, message, .. } => (doc.path_at(line, &message), message),
+        fretdyn::Error::Invalid { field, message } => (Some(field), message),
+        other => (None, other.to_string()),
     }
+}
+
+/// The case of a dict with the structure of a case file; an error is the key path it is at
+/// (if any) and the rest of its message.
+fn case_from_map_at(
+    root: &serde_json::Map<String, serde_json::Value>,
+    base_dir: &Path,
+) -> Result<Case, (Option<String>, String)> {
+    let doc = Document::from_json(root).map_err(|e| (None, e))?;
+    fretdyn::case::Case::from_toml_str(&doc.text, base_dir)
+        .map(|inner| Case {
+            inner,
+            base_dir: absolute(base_dir),
+        })
+        .map_err(|e| dict_error_at(&doc, e))
 }
 
 /// The case of a dict with the structure of a case file.
@@ -195,13 +217,63 @@ fn case_from_map(
     root: &serde_json::Map<String, serde_json::Value>,
     base_dir: &Path,
 ) -> PyResult<Case> {
-    let doc = Document::from_json(root).map_err(FretdynError::new_err)?;
-    fretdyn::case::Case::from_toml_str(&doc.text, base_dir)
-        .map(|inner| Case {
-            inner,
-            base_dir: absolute(base_dir),
+    case_from_map_at(root, base_dir).map_err(|(path, message)| {
+        FretdynError::new_err(match path {
+            Some(path) => format!("{path}: {message}"),
+            None => message,
         })
-        .map_err(|e| dict_error(&doc, e))
+    })
+}
+
+/// Whether a part of a key path given to `case_with` (`*` for any element) stands for a part
+/// of the path an error is at.
+fn same_part(given: &fretdyn::case::key_path::Part, at: &fretdyn::case::key_path::Part) -> bool {
+    use fretdyn::case::key_path::Part;
+    match (given, at) {
+        (Part::Every, Part::Index(_) | Part::Every) => true,
+        (Part::Index(i), Part::Key(k)) | (Part::Key(k), Part::Index(i)) => *k == i.to_string(),
+        _ => given == at,
+    }
+}
+
+/// The message of an error of `case_with` at the key path `at` (in the notation of the dict,
+/// `contacts[1]`), named by the key path the user gave for it, exactly as given: the last of
+/// `changes` whose path goes through `at` (`at` is that path, or a part of it, or one element
+/// of its `*`). `contacts.1.obstacle.gap: no such element; …` when `at` is the key path given
+/// in another notation; `tim.dt: tim: unknown field …` when it is a part of it. An error
+/// below a key path given (in the value set there) or at none keeps its path.
+fn named_by_change(
+    changes: &[(&str, fretdyn::case::key_path::KeyPath)],
+    at: Option<&str>,
+    message: &str,
+) -> String {
+    use fretdyn::case::key_path::{KeyPath, abbreviated};
+    let Some(at) = at else {
+        return message.to_string();
+    };
+    let plain = format!("{}: {message}", abbreviated(at));
+    let Ok(path) = KeyPath::parse(at) else {
+        return plain;
+    };
+    let given = changes.iter().rev().find(|(_, key)| {
+        path.parts.len() <= key.parts.len()
+            && key
+                .parts
+                .iter()
+                .zip(&path.parts)
+                .all(|(g, a)| same_part(g, a))
+    });
+    match given {
+        Some((text, _)) if *text == at => plain,
+        Some((text, key))
+            if key.parts.len() == path.parts.len()
+                && !key.parts.contains(&fretdyn::case::key_path::Part::Every) =>
+        {
+            format!("{}: {message}", abbreviated(text))
+        }
+        Some((text, _)) => format!("{}: {}: {message}", abbreviated(text), abbreviated(at)),
+        None => plain,
+    }
 }
 
 /// A case from JSON text with the structure of a case file (how Python dicts come in). It is
@@ -215,28 +287,42 @@ fn case_from_json(json: &str, base_dir: PathBuf) -> PyResult<Case> {
 
 /// A new case: `case` with the values of `changes`, JSON `[[key path, value], …]` applied in
 /// order. A key path is that of a study parameter (`fretdyn::case::key_path`:
-/// `contacts[0].obstacle.clearance`, `contacts.*.friction.mu`); missing keys of tables are
-/// added, then the case's parser checks them. Errors name the key path.
+/// `contacts[0].obstacle.clearance`, `contacts.*.friction.mu`; at most
+/// `key_path::MAX_PARTS` parts); missing keys of tables are added, then the case's parser
+/// checks them. Errors start with the key path exactly as given (its start and its length
+/// when it is long), then where it fails when that is a part of it
+/// (`contacts[1].obstacle.gap: contacts[1]: no such element; …`).
 #[pyfunction]
 fn case_with(case: &Case, changes: &str) -> PyResult<Case> {
-    use fretdyn::case::key_path::{KeyPath, Missing};
+    use fretdyn::case::key_path::{KeyPath, Missing, abbreviated};
     let changes: Vec<(String, serde_json::Value)> = serde_json::from_str(changes)
         .map_err(|e| FretdynError::new_err(format!("the changes are not valid JSON: {e}")))?;
     let mut value: toml::Value = toml::Value::try_from(&case.inner.echo)
         .map_err(|e| FretdynError::new_err(format!("the case cannot be changed: {e}")))?;
+    let mut paths = Vec::with_capacity(changes.len());
     for (key, new) in &changes {
+        let shown = abbreviated(key);
         let new = match new {
             serde_json::Value::Null => {
                 return Err(FretdynError::new_err(format!(
-                    "{key}: None is not a value of a case (leave the key out)"
+                    "{shown}: None is not a value of a case (leave the key out)"
                 )));
             }
             v => toml::Value::try_from(v)
-                .map_err(|e| FretdynError::new_err(format!("{key}: {e}")))?,
+                .map_err(|e| FretdynError::new_err(format!("{shown}: {e}")))?,
         };
-        KeyPath::parse(key)
-            .and_then(|path| path.set(&mut value, &new, Missing::Create))
-            .map_err(|e| FretdynError::new_err(e.to_string()))?;
+        // a text that is no key path, or too deep, names itself
+        let path = KeyPath::parse(key).map_err(|e| FretdynError::new_err(e.to_string()))?;
+        path.set(&mut value, &new, Missing::Create).map_err(|e| {
+            let message = e.to_string();
+            let at = e.at().unwrap_or_default();
+            let rest = message.strip_prefix(&format!("{}: ", abbreviated(at)));
+            FretdynError::new_err(match rest {
+                Some(rest) => named_by_change(&[(key.as_str(), path.clone())], Some(at), rest),
+                None => message,
+            })
+        })?;
+        paths.push((key.as_str(), path));
     }
     let json = serde_json::to_value(&value)
         .map_err(|e| FretdynError::new_err(format!("the case cannot be changed: {e}")))?;
@@ -247,7 +333,9 @@ fn case_with(case: &Case, changes: &str) -> PyResult<Case> {
         root.entry("title")
             .or_insert_with(|| serde_json::Value::String(case.inner.title.clone()));
     }
-    case_from_map(&root, &case.base_dir)
+    case_from_map_at(&root, &case.base_dir).map_err(|(at, message)| {
+        FretdynError::new_err(named_by_change(&paths, at.as_deref(), &message))
+    })
 }
 
 /// Runs a case with the GIL released; Ctrl-C stops it (KeyboardInterrupt). Returns a dict of

@@ -9,6 +9,7 @@ import os
 import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -357,28 +358,113 @@ def test_with_adds_a_table_the_case_has_not():
     assert same_bits(r0.q, r1.q)
 
 
-def test_errors_of_with_name_the_key_path():
+def test_errors_of_with_name_the_key_path_exactly_as_given():
+    # the key path as given first, then where it fails when that is a part of it
     case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
     cases = [
         ({"contacts[0].obstacle.clearance": 2e-4},
          "contacts[0].obstacle.clearance: unknown field `clearance`, expected one of"),
         ({"contacts[1].obstacle.gap": 1e-4},
-         "contacts[1]: no such element; contacts has 1 element (index 0)"),
+         "contacts[1].obstacle.gap: contacts[1]: no such element; contacts has 1 element (index 0)"),
+        ({"contacts.1": 1e-4}, "contacts.1: no such element; contacts has 1 element (index 0)"),
         ({"contacts.obstacle.gap": 1e-4},
-         "contacts.obstacle: contacts is a list of 1: give an index (contacts[0])"),
+         "contacts.obstacle.gap: contacts.obstacle: contacts is a list of 1: give an index (contacts[0])"),
         ({"time.dt.value": 1e-6}, "time.dt.value: time.dt is a value"),
         ({"time[0]": 1e-6}, "time[0]: time is a table, not a list: give one of its keys"),
-        ({"tim.dt": 1e-6}, "tim: unknown field `tim`, expected one of"),
+        ({"tim.dt": 1e-6}, "tim.dt: tim: unknown field `tim`, expected one of"),
+        # a table the case has not, however deep the path below it (was named time.a.a)
+        ({"time.a.a.a.a": 1.0}, "time.a.a.a.a: time.a: unknown field `a`, expected `dt` or `duration`"),
         ({"time.dt": "small"}, "time.dt: invalid type: string \"small\", expected f64"),
-        ({"contacts[0].normal.stiffness": -1.0}, "contacts[0].normal.stiffness: "),
+        ({"contacts[0].normal.stiffness": -1.0}, "contacts[0].normal.stiffness: must be a positive"),
+        ({"contacts.0.normal.stiffness": -1.0}, "contacts.0.normal.stiffness: must be a positive"),
+        ({"contacts.*.normal.stiffness": -1.0},
+         "contacts.*.normal.stiffness: contacts[0].normal.stiffness: must be a positive"),
         ({"time.dt": None}, "time.dt: None is not a value"),
         ({"contacts[0": 1.0}, "'contacts[0' is not a key path: a [ is not closed"),
+        # of two changes, the one the error is at
+        ({"time.dt": 1e-6, "contacts[0].friction.nu": 0.2},
+         "contacts[0].friction.nu: unknown field `nu`"),
+        # a value set at a key path: the path of the value inside it
+        ({"contacts[0].friction": {"mu": -1.0}}, "contacts[0].friction.mu: must be a friction"),
     ]
     for changes, message in cases:
         with pytest.raises(fretdyn.FretdynError) as e:
             case.with_(changes)
         assert str(e.value).startswith(message), (changes, str(e.value))
         assert "line " not in str(e.value), str(e.value)
+
+
+def test_a_long_key_path_is_named_by_its_start_and_its_length():
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    key = "time." + ".".join(["part"] * 60)  # 61 parts, 304 characters: legal
+    with pytest.raises(fretdyn.FretdynError) as e:
+        case.with_({key: 1.0})
+    message = str(e.value)
+    assert message.startswith(
+        f"{key[:100]}… (a key path of {len(key)} characters, the first 100 shown): "
+        "time.part: unknown field `part`"), message
+    # up to 200 characters, named whole
+    key = "time.dt." + ".".join(["x"] * 60)  # 127 characters
+    with pytest.raises(fretdyn.FretdynError) as e:
+        case.with_({key: 1.0})
+    assert str(e.value) == f"{key}: time.dt.x: time.dt is a value (0.000001), not a table or a list"
+
+
+def test_a_key_path_deeper_than_64_parts_is_refused_at_once():
+    # a path built by mistake (a loop appending to it): 10 000 parts took 24 GB and was killed
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    tail = "a key path has at most 64 parts and this one has more: no key of a case is that deep"
+    for key in [".".join(["a"] * 10_000), "time" + ".x" * 10_000, "contacts" + "[0]" * 64,
+                ".".join(["a"] * 65)]:
+        start = time.perf_counter()
+        with pytest.raises(fretdyn.FretdynError) as e:
+            case.with_({key: 1.0})
+        assert time.perf_counter() - start < 1.0
+        message = str(e.value)
+        assert tail in message, message
+        assert len(message) < 400 and message.startswith(key[:100]), message
+        if len(key) > 200:
+            assert f"(a key path of {len(key)} characters, the first 100 shown)" in message
+    # at the bound the path is read, and the case's parser answers, at once: the time and
+    # memory of a path are linear in its length
+    for key in [".".join(["a"] * 64), "time" + ".x" * 63, "contacts" + "[0]" * 63]:
+        start = time.perf_counter()
+        with pytest.raises(fretdyn.FretdynError) as e:
+            case.with_({key: 1.0})
+        assert time.perf_counter() - start < 1.0
+        assert tail not in str(e.value) and "recursion" not in str(e.value), str(e.value)
+    # a study's parameter key: the same parser, the same bound
+    study = {"base": case, "parameters": [{"key": ".".join(["a"] * 10_000), "values": [1.0]}]}
+    with pytest.raises(fretdyn.FretdynError) as e:
+        fretdyn.sweep(study)
+    assert str(e.value).startswith("parameters[0].key: a.a.a") and tail in str(e.value), str(e.value)
+
+
+def test_a_dict_nested_deeper_than_a_key_path_is_refused():
+    # as deep as Python's recursion allowed: refused at part 65 with its key path (was a
+    # RecursionError, JSON's "recursion limit exceeded at line 1 column 1535", or a TOML
+    # "recursion limit exceeded" at a path cut at 80 parts)
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    deep = case.to_dict()
+    table = deep["time"]
+    for _ in range(900):
+        table["a"] = {}
+        table = table["a"]
+    looped = {}
+    looped["a"] = looped
+    tail = ": nested more than 64 keys and indices deep: no key of a case is that deep"
+    for given, start in [(deep, "time" + ".a" * 64), (looped, ".".join(["a"] * 65))]:
+        with pytest.raises(fretdyn.FretdynError) as e:
+            fretdyn.Case.from_dict(given)
+        assert str(e.value).startswith(start[:100]) and tail in str(e.value), str(e.value)
+    # a value given to with_ below a key path: the whole path counts
+    with pytest.raises(fretdyn.FretdynError) as e:
+        case.with_({"time" + ".a" * 40: {"b": np.zeros((1,) * 30).tolist()}})
+    assert tail in str(e.value), str(e.value)
+    with pytest.raises(fretdyn.FretdynError) as e:
+        case.with_({"initial.velocity": np.zeros((1,) * 64)})
+    assert str(e.value).startswith(("initial.velocity" + "[0]" * 63)[:100]), str(e.value)
+    assert tail in str(e.value), str(e.value)
 
 
 def test_to_dict_round_trips_every_example():
@@ -513,6 +599,36 @@ def test_a_probabilistic_dict_study_gives_its_percentiles(tmp_path):
     p = fretdyn.percentiles(study, tmp_path / "p.csv")
     (row,) = [r for r in p["rows"] if r["column"] == "plane.wear_work_rate"]
     assert row["estimate"] == pytest.approx(np.percentile(t["plane.wear_work_rate"], 50), rel=1e-12)
+
+
+def test_what_one_sample_cannot_give_is_an_empty_cell_and_null(tmp_path):
+    # one sample: no interval, no bootstrap error. percentiles.csv wrote NaN where
+    # percentiles.json has null; the study table's convention is an empty cell
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    study = {
+        "base": case, "samples": 1, "seed": 2,
+        "parameters": [{"key": "contacts[0].friction.mu",
+                        "distribution": {"type": "uniform", "low": 0.1, "high": 0.5}}],
+        "percentiles": {"statistics": ["wear_work_rate"]},
+    }
+    fretdyn.sweep(study, tmp_path / "study.csv")
+    p = fretdyn.percentiles(study, tmp_path / "study.csv", output=tmp_path)
+    text = (tmp_path / "percentiles.csv").read_text()
+    assert "nan" not in text.lower(), text
+    assert json.loads((tmp_path / "percentiles.json").read_text()) == p
+    table = fretdyn.read_table(tmp_path / "percentiles.csv")
+    numbers = ["estimate", "ci_low", "ci_high", "ci_coverage", "bootstrap_se"]
+    assert [r["level"] for r in p["rows"]] == [50, 95, 99]
+    for i, row in enumerate(p["rows"]):
+        assert row["n"] == 1 and row["ci_high"] is None and row["bootstrap_se"] is None
+        for k in numbers:
+            # NaN read back exactly where the JSON has null
+            assert np.isnan(table[k][i]) == (row[k] is None), (k, row)
+            if row[k] is not None:
+                assert table[k][i] == row[k]
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(tmp_path / "percentiles.csv")
+    assert frame["bootstrap_se"].isna().all() and frame["estimate"].notna().all()
 
 
 def test_errors_of_a_dict_study_name_the_key():

@@ -129,6 +129,48 @@ def test_errors_of_a_dict_name_its_key_path():
     assert error(second).startswith("contacts[1].normal.stiffness: ")
 
 
+def test_nan_and_infinities_in_a_dict_are_named_by_their_key_path():
+    # JSON has no NaN: the message was JSON's ("the case is not valid JSON: expected value at
+    # line 1 column 35"), the position of a text the user never saw
+    def error(call):
+        with pytest.raises(fretdyn.FretdynError) as e:
+            call()
+        message = str(e.value)
+        assert "JSON" not in message and "line" not in message and "column" not in message
+        return message
+
+    contact = lambda c: c["contacts"][0]
+    for x, shown in [(float("nan"), "NaN"), (float("inf"), "inf"), (-np.inf, "-inf")]:
+        tail = f": {shown} is not a valid value: give a finite number"
+        cases = [
+            (lambda c: contact(c)["friction"].update(mu=x), "contacts[0].friction.mu"),
+            (lambda c: c["time"].update(dt=np.float64(x)), "time.dt"),
+            (lambda c: c["initial"].update(velocity=np.array([0.0, x, 0.0])), "initial.velocity[1]"),
+            (lambda c: c["initial"].update(velocity=[0.0, 0.0, np.float32(x)]), "initial.velocity[2]"),
+        ]
+        for change, path in cases:
+            case = v1a_dict()
+            change(case)
+            assert error(lambda: fretdyn.Case.from_dict(case)) == path + tail
+        case = fretdyn.Case.from_dict(v1a_dict())
+        # with_, at the key path or inside the value given there
+        assert error(lambda: case.with_({"contacts[0].friction.mu": x})) == "contacts[0].friction.mu" + tail
+        assert error(lambda: case.with_({"contacts[0].friction": {"mu": x}})) == "contacts[0].friction.mu" + tail
+        assert error(lambda: case.with_(**{"initial.velocity": np.array([[0.0, x]])})) == "initial.velocity[0][1]" + tail
+        # a study's values, and its base case
+        study = {"base": case, "parameters": [{"key": "time.dt", "values": [1e-6, x]}]}
+        assert error(lambda: fretdyn.sweep(study)) == "parameters[0].values[1]" + tail
+        base = v1a_dict()
+        contact(base)["friction"]["mu"] = x
+        study = {"base": base, "parameters": [{"key": "time.dt", "values": [1e-6]}]}
+        assert error(lambda: fretdyn.sweep(study)) == "base.contacts[0].friction.mu" + tail
+        # the arrays of a modal basis
+        assert error(lambda: fretdyn.modal_structure([1.0, x], {"A": np.ones((3, 2))})) == (
+            "structure.frequencies_hz[1]" + tail)
+        assert error(lambda: fretdyn.modal_structure([1.0], {"A": [[1.0], [x], [0.0]]})) == (
+            "structure.points.A.rows[1][0]" + tail)
+
+
 def test_run_takes_the_path_of_a_case_file(tmp_path):
     path = EXAMPLES / "v1a_oblique_impact.toml"
     reference = fretdyn.run(fretdyn.Case.from_file(path))

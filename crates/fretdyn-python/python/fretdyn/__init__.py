@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import os
 import tempfile
 from collections.abc import Mapping
@@ -45,19 +46,103 @@ __version__ = _native.__version__
 PathLike = Union[str, os.PathLike]
 
 
-def _plain(value: Any) -> Any:
-    """numpy arrays and scalars → lists and Python numbers (for JSON)."""
+# The most parts of a key path (fretdyn::case::key_path::MAX_PARTS): no key of a case is deeper,
+# and a dict nested deeper is refused (a dict that holds itself, too).
+_MAX_PARTS = 64
+
+
+class _Unfit(Exception):
+    """A value a case cannot hold, found under the keys and indices `parts` (innermost
+    first): NaN or an infinity (JSON has neither; a case takes neither from a dict), or a
+    value nested more than `_MAX_PARTS` deep."""
+
+    def __init__(self, problem: str):
+        super().__init__(problem)
+        self.problem = problem
+        self.parts: List[Union[str, int]] = []
+
+
+def _number(x: float) -> str:
+    """A non-finite float as the Rust messages show it: NaN, inf, -inf."""
+    return "NaN" if x != x else ("inf" if x > 0 else "-inf")
+
+
+def _non_finite(x: float) -> _Unfit:
+    return _Unfit(f"{_number(x)} is not a valid value: give a finite number")
+
+
+def _too_deep() -> _Unfit:
+    return _Unfit(
+        f"nested more than {_MAX_PARTS} keys and indices deep: no key of a case is that deep "
+        f"(a key path has at most {_MAX_PARTS} parts)"
+    )
+
+
+def _plain(value: Any, depth: int = 0) -> Any:
+    """numpy arrays and scalars → lists and Python numbers (for JSON). `depth`: the parts of
+    the key path of `value`. Raises _Unfit for NaN, ±inf, or a value deeper than
+    `_MAX_PARTS`."""
+    if depth > _MAX_PARTS:
+        raise _too_deep()
     if isinstance(value, np.ndarray):
+        if value.dtype.kind == "O":
+            return _plain(value.tolist(), depth)
+        if value.size and depth + value.ndim > _MAX_PARTS:
+            e = _too_deep()  # at its first element, as a list would be
+            e.parts = [0] * (_MAX_PARTS + 1 - depth)
+            raise e
+        if value.dtype.kind == "f" and not np.isfinite(value).all():
+            where = tuple(int(i) for i in np.argwhere(~np.isfinite(value))[0])
+            e = _non_finite(float(value[where]))
+            e.parts = list(reversed(where))
+            raise e
         return value.tolist()
     if isinstance(value, np.generic):
-        return value.item()
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        raise _non_finite(value)
     if isinstance(value, Case):
         return value.to_dict()
     if isinstance(value, Mapping):
-        return {str(k): _plain(v) for k, v in value.items()}
+        out = {}
+        for k, v in value.items():
+            try:
+                out[str(k)] = _plain(v, depth + 1)
+            except _Unfit as e:
+                e.parts.append(str(k))
+                raise
+        return out
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        items = []
+        for i, v in enumerate(value):
+            try:
+                items.append(_plain(v, depth + 1))
+            except _Unfit as e:
+                e.parts.append(i)
+                raise
+        return items
     return value
+
+
+def _shown(path: str) -> str:
+    """A key path as the messages name it (fretdyn::case::key_path::abbreviated): whole up to
+    200 characters, else its first 100 and its length."""
+    if len(path) <= 200:
+        return path
+    return f"{path[:100]}… (a key path of {len(path)} characters, the first 100 shown)"
+
+
+def _checked(value: Any, path: str = "") -> Any:
+    """`_plain(value)` for a case, a study or a value of `Case.with_` at the key path `path`;
+    what a case cannot hold is a FretdynError naming its key path
+    (``contacts[0].friction.mu: NaN is not a valid value: give a finite number``)."""
+    try:
+        return _plain(value)
+    except _Unfit as e:
+        for part in reversed(e.parts):
+            path = f"{path}[{part}]" if isinstance(part, int) else (
+                f"{path}.{part}" if path else part)
+        raise FretdynError(f"{_shown(path)}: {e.problem}") from None
 
 
 def _pandas():
@@ -203,7 +288,9 @@ class Case:
         ----------
         case : Mapping
             The tables of a case file as dicts, arrays of tables as lists of dicts; numpy
-            arrays and numbers are accepted anywhere a list or a number is.
+            arrays and numbers are accepted anywhere a list or a number is. Numbers are
+            finite (JSON, which carries the dict, has no NaN or infinity), and no value is
+            more than 64 keys and indices deep (no key of a case is).
         base_dir : str or os.PathLike, default "."
             Folder its relative file names are resolved from.
 
@@ -215,22 +302,24 @@ class Case:
         ------
         FretdynError
             The message starts with the key path in the dict (``time.dt``,
-            ``contacts[0].normal.stiffness``).
+            ``contacts[0].normal.stiffness``), for a NaN or an infinity too
+            (``contacts[0].friction.mu: NaN is not a valid value: give a finite number``).
 
         Examples
         --------
         >>> case = fretdyn.Case.from_dict(other.to_dict())
         """
-        return cls(_native.case_from_json(json.dumps(_plain(case)), os.fspath(base_dir)))
+        return cls(_native.case_from_json(json.dumps(_checked(case)), os.fspath(base_dir)))
 
     def with_(self, changes: Optional[Mapping[str, Any]] = None, /, **values: Any) -> "Case":
         """A copy of the case with some values changed, by the key paths of studies.
 
         A key path is dotted keys with indices: ``time.dt``, ``contacts[0].friction.mu``
         (or ``contacts.0.friction.mu``), ``contacts.*.obstacle.clearance`` (``*``: every
-        element). Keys missing from a table are added (``output.every``), then the case is
-        read again as a whole: a key the case format does not have, or a value it does not
-        take, is an error naming the key path.
+        element), of at most 64 parts (a longer one, built by mistake, is refused at once).
+        Keys missing from a table are added (``output.every``), then the case is read again
+        as a whole: a key the case format does not have, or a value it does not take, is an
+        error naming the key path.
 
         Parameters
         ----------
@@ -248,8 +337,12 @@ class Case:
         Raises
         ------
         FretdynError
-            The message starts with the key path: ``contacts[2]: no such element; contacts
-            has 1 element (index 0)``.
+            The message starts with the key path exactly as given (one of more than 200
+            characters: its first 100 and its length), then where it fails when that is a
+            part of it: ``contacts[2].obstacle.gap: contacts[2]: no such element; contacts
+            has 1 element (index 0)``, ``contacts.*.friction.mu: contacts[1].friction.mu:
+            must be a friction coefficient ≥ 0 (got -0.1)``; a NaN or an infinity in a value:
+            ``time.dt: NaN is not a valid value: give a finite number``.
 
         Examples
         --------
@@ -257,7 +350,7 @@ class Case:
         >>> fine = case.with_(**{"time.dt": 5e-7, "contacts[0].friction.mu": 0.2})
         """
         items = [*(changes or {}).items(), *values.items()]
-        pairs = [[str(k), _plain(v)] for k, v in items]
+        pairs = [[str(k), _checked(v, str(k))] for k, v in items]
         return Case(_native.case_with(self._native, json.dumps(pairs)))
 
     def to_dict(self) -> dict:
@@ -351,7 +444,8 @@ def modal_structure(
     Raises
     ------
     FretdynError
-        Rows of the wrong shape.
+        Rows of the wrong shape; a NaN or an infinity, named
+        (``structure.frequencies_hz[1]: NaN is not a valid value: give a finite number``).
 
     Examples
     --------
@@ -360,9 +454,11 @@ def modal_structure(
     p = len(frequencies_hz)
     structure: dict = {
         "type": "modal",
-        "frequencies_hz": _plain(np.asarray(frequencies_hz, dtype=float)),
-        "damping_ratio": _plain(
-            np.zeros(p) if damping_ratio is None else np.asarray(damping_ratio, dtype=float)
+        "frequencies_hz": _checked(np.asarray(frequencies_hz, dtype=float),
+                                   "structure.frequencies_hz"),
+        "damping_ratio": _checked(
+            np.zeros(p) if damping_ratio is None else np.asarray(damping_ratio, dtype=float),
+            "structure.damping_ratio",
         ),
         "points": [],
     }
@@ -370,9 +466,10 @@ def modal_structure(
         rows = np.asarray(rows, dtype=float)
         if rows.shape != (3, p):
             raise FretdynError(f"structure.points.{name}: rows must have shape (3, {p}), got {rows.shape}")
-        point = {"name": name, "rows": _plain(rows)}
+        point = {"name": name, "rows": _checked(rows, f"structure.points.{name}.rows")}
         if coords and name in coords:
-            point["coords"] = _plain(np.asarray(coords[name], dtype=float))
+            point["coords"] = _checked(np.asarray(coords[name], dtype=float),
+                                       f"structure.points.{name}.coords")
         structure["points"].append(point)
     return structure
 
@@ -729,7 +826,7 @@ def _study_source(study: Union[PathLike, Mapping[str, Any]], base_dir: Optional[
             raise FretdynError(f"base.{e}") from None
     elif isinstance(base, os.PathLike):
         study["base"] = os.fspath(base)
-    return (json.dumps(_plain(study)), folder)
+    return (json.dumps(_checked(study)), folder)
 
 
 def _row(study: Any, index: int) -> str:
@@ -860,7 +957,9 @@ def percentiles(
     table : str or os.PathLike
         Its table.
     output : str or os.PathLike, optional
-        A folder to write ``percentiles.csv`` and ``percentiles.json`` into.
+        A folder to write ``percentiles.csv`` and ``percentiles.json`` into. A value the
+        samples cannot give is an empty cell of ``percentiles.csv``, as in the study table
+        (`read_table` and pandas read NaN), and ``null`` in ``percentiles.json``.
     base_dir : str or os.PathLike, optional
         For a dict study, as in `sweep`.
 
@@ -869,9 +968,10 @@ def percentiles(
     dict or None
         ``{"confidence", "bootstrap_resamples", "seed", "rows": [{"group", "column",
         "level", "n", "excluded", "estimate", "ci_low", "ci_high", "ci_coverage",
-        "bootstrap_se"}, ...]}`` (P50, P95, P99 by default; ``None`` for a bound too few
-        samples give); ``None`` when the study asks for no percentiles (no ``samples``, no
-        ``[percentiles]``).
+        "bootstrap_se"}, ...]}`` (P50, P95, P99 by default; ``None`` for what too few
+        samples cannot give: a bound, the bootstrap error of fewer than 2 values, the
+        estimate of none); ``None`` when the study asks for no percentiles (no ``samples``,
+        no ``[percentiles]``).
 
     Examples
     --------
@@ -891,7 +991,8 @@ def read_table(table: PathLike) -> dict:
     Parameters
     ----------
     table : str or os.PathLike
-        A CSV table written by `sweep` or ``fretdyn sweep``.
+        A CSV table written by `sweep` or ``fretdyn sweep`` (``study.csv``, or its
+        ``percentiles.csv``).
 
     Returns
     -------

@@ -99,10 +99,32 @@ class ModalBasis:
         """Number of modes p."""
         return len(self.frequencies_hz)
 
+    def check(self) -> None:
+        """Refuses, with a `FretdynError` naming the attribute, what the case file would
+        refuse (a basis changed after it was read): frequencies not finite or < 0, damping
+        ratios < 0 or not one per mode, rows not finite. `arrays`, `write_npz` and `structure`
+        check first, so that no such basis is written."""
+        freq = _numbers(self.frequencies_hz, "frequencies_hz", "one frequency per mode, Hz")
+        _each(freq.reshape(-1), "frequencies_hz", lambda x: np.isfinite(x) and x >= 0.0,
+              "must be a finite frequency ≥ 0 (0 is a rigid-body mode)")
+        damping = _damping_ratios(self.damping_ratio)
+        if damping.shape != freq.shape:
+            raise FretdynError(
+                f"damping_ratio: has {damping.size} values for {freq.size} modes: give one per mode"
+            )
+        for name, pt in self.points.items():
+            for what, rows in (("rows", pt.rows), ("rotations", pt.rotations)):
+                if rows is not None and not np.isfinite(np.asarray(rows, dtype=float)).all():
+                    raise FretdynError(
+                        f"points['{name}'].{what}: mode shape is not finite: fix or drop that mode"
+                    )
+
     def arrays(self) -> Dict[str, np.ndarray]:
         """The arrays of fretdyn's `.npz` basis (keys of `crates/fretdyn/src/structure/
         basis_file.rs`): `frequencies_hz`, `damping_ratio`, `rows_<name>`, `coords_<name>`,
-        `rotations_<name>` when read, `participation` when read; all float64."""
+        `rotations_<name>` when read, `participation` when read; all float64. Checked first
+        (`check`)."""
+        self.check()
         out: Dict[str, np.ndarray] = {
             "frequencies_hz": _f64(self.frequencies_hz),
             "damping_ratio": _f64(self.damping_ratio),
@@ -127,7 +149,9 @@ class ModalBasis:
 
     def structure(self) -> dict:
         """The `[structure]` section of a case with this basis inline, for
-        `fretdyn.Case.from_dict` (`{"type": "modal", "frequencies_hz": …, "points": […]}`)."""
+        `fretdyn.Case.from_dict` (`{"type": "modal", "frequencies_hz": …, "points": […]}`).
+        Checked first (`check`)."""
+        self.check()
         s: Dict[str, Any] = {
             "type": "modal",
             "frequencies_hz": self.frequencies_hz.tolist(),
@@ -157,6 +181,78 @@ class ModalBasis:
 
 def _f64(a: Any) -> np.ndarray:
     return np.ascontiguousarray(np.asarray(a, dtype=np.float64))
+
+
+def _shown(x: float) -> str:
+    """A number as the case file's messages show it: NaN, inf, -inf, or Python's repr."""
+    x = float(x)
+    return "NaN" if x != x else ("inf" if x == np.inf else ("-inf" if x == -np.inf else repr(x)))
+
+
+def _numbers(value: Any, name: str, expected: str) -> np.ndarray:
+    """`value` — a number or a 1-D sequence of numbers (bool and str are not) — as float64;
+    anything else is a FretdynError naming the argument `name` and saying `expected`."""
+    raw = None
+    if not isinstance(value, (str, bytes)):
+        try:
+            raw = np.asarray(value)
+        except (TypeError, ValueError):
+            raw = None
+    if raw is None or raw.dtype.kind not in "iuf":
+        raise FretdynError(f"{name}: must be {expected}, not {value!r}")
+    if raw.ndim > 1:
+        raise FretdynError(f"{name}: must be {expected}, not an array of shape {raw.shape}")
+    return raw.astype(np.float64)
+
+
+def _each(values: np.ndarray, name: str, good, message: str) -> None:
+    """A FretdynError `name[i]: message (got x)` (`name: …` for one number) for the first
+    value that is not `good`."""
+    for i, x in enumerate(values.reshape(-1)):
+        if not good(x):
+            where = name if values.ndim == 0 else f"{name}[{i}]"
+            raise FretdynError(f"{where}: {message} (got {_shown(x)})")
+
+
+def _damping_ratios(value: Any) -> np.ndarray:
+    """The `damping_ratio` argument: one number or one per mode, each a damping ratio ≥ 0 as
+    the case file takes it (`structure.damping_ratio`, the same words)."""
+    d = _numbers(value, "damping_ratio", "a damping ratio, or one per mode (e.g. 0.01 for 1 %)")
+    _each(d, "damping_ratio", lambda x: np.isfinite(x) and x >= 0.0,
+          "must be a damping ratio ≥ 0, e.g. 0.01 for 1 %")
+    return d
+
+
+def _generalised_masses(value: Any) -> np.ndarray:
+    """The `generalized_masses` argument: one `φᵀ M φ` per mode kept, each finite and > 0."""
+    m = _numbers(value, "generalized_masses", "one generalised mass φᵀ M φ per mode kept")
+    _each(m, "generalized_masses", lambda x: np.isfinite(x) and x > 0.0,
+          "must be a generalised mass φᵀ M φ > 0 (finite)")
+    return m.reshape(-1)
+
+
+def _mode_numbers(value: Any) -> Optional[List[int]]:
+    """The `modes` argument: None, or NUME_ORDRE (ints), each once, at least one."""
+    if value is None:
+        return None
+    if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Iterable):
+        raise FretdynError(f"modes: must be a list of NUME_ORDRE (ints), not {value!r}")
+    numbers = list(value)
+    for i, m in enumerate(numbers):
+        if isinstance(m, (bool, np.bool_)) or not isinstance(m, (int, np.integer)):
+            raise FretdynError(f"modes[{i}]: must be a NUME_ORDRE (an int), not {m!r}")
+    if not numbers:
+        raise FretdynError("modes is empty: keep at least one mode")
+    if len(set(int(m) for m in numbers)) != len(numbers):
+        raise FretdynError(f"modes lists a NUME_ORDRE twice: {[int(m) for m in numbers]}")
+    return [int(m) for m in numbers]
+
+
+def _flag(value: Any, name: str, none: bool = False) -> None:
+    """A bool argument (or None when `none`): 'yes' or 0 is not silently taken for one."""
+    if not (isinstance(value, (bool, np.bool_)) or (none and value is None)):
+        allowed = "True, False or None" if none else "True or False"
+        raise FretdynError(f"{name}: must be {allowed}, not {value!r}")
 
 
 def _medcoupling():
@@ -202,10 +298,15 @@ def _points_by_name(points: Any, path: Path) -> List[Tuple[str, Union[str, int]]
     for name, where in items:
         if not isinstance(name, str) or not name.strip():
             raise FretdynError(f"{path}: point name {name!r} must be a non-empty str")
-        if isinstance(where, bool) or not isinstance(where, (str, int, np.integer)):
+        if isinstance(where, (bool, np.bool_)) or not isinstance(where, (str, int, np.integer)):
             raise FretdynError(
                 f"{path}: point '{name}': {where!r} is neither a node group name (str) nor a "
                 f"node number (int, from 1)"
+            )
+        if not isinstance(where, str) and where < 1:
+            raise FretdynError(
+                f"{path}: point '{name}': node {where} is not a node number: nodes are "
+                f"numbered from 1, as in Code_Aster and Salome"
             )
     return [(name, where if isinstance(where, str) else int(where)) for name, where in items]
 
@@ -302,13 +403,23 @@ def read_modal_basis(
       with `radius`); None: when the field has them.
 
     The frequencies are the time values of the MED steps (Code_Aster writes `FREQ` there);
-    each shape is divided by √`MASS_GENE`. Bad input raises `FretdynError` naming the file and
-    what is wrong in it; without medcoupling, ImportError."""
-    mc = _medcoupling()
+    each shape is divided by √`MASS_GENE`. An argument out of range (a negative damping ratio,
+    a generalised mass ≤ 0, a NaN, a mode number that is not an int, a node number below 1)
+    raises `FretdynError` naming it, in the words of the case file's errors, before the file
+    is opened; bad input in the file raises `FretdynError` naming the file and what is wrong
+    in it; without medcoupling, ImportError."""
+    damping = _damping_ratios(damping_ratio)
+    given_masses = None if generalized_masses is None else _generalised_masses(generalized_masses)
+    modes = _mode_numbers(modes)
+    _flag(mass_normalized, "mass_normalized")
+    _flag(rotations, "rotations", none=True)
+    if field is not None and not isinstance(field, str):
+        raise FretdynError(f"field: must be the name of a MED field (a str) or None, not {field!r}")
     path = Path(path)
+    wanted = _points_by_name(points, path)
+    mc = _medcoupling()
     if not path.is_file():
         raise FretdynError(f"{path}: no such file (a MED file written by IMPR_RESU(FORMAT='MED'))")
-    wanted = _points_by_name(points, path)
     try:
         fname = _choose_field(mc, path, field)
         fts = mc.MEDFileFieldMultiTS.New(str(path), fname, False)
@@ -318,20 +429,15 @@ def read_modal_basis(
     if not steps:
         raise FretdynError(f"{path}: field '{fname}' has no time step (one per mode is expected)")
     if modes is not None:
-        modes = list(modes)
         by_number = {it: (it, order, t) for it, order, t in steps}
         chosen = []
         for m in modes:
-            if isinstance(m, bool) or not isinstance(m, (int, np.integer)) or int(m) not in by_number:
+            if m not in by_number:
                 raise FretdynError(
                     f"{path}: modes: no mode with NUME_ORDRE {m!r} in field '{fname}' "
                     f"(NUME_ORDRE in the file: {sorted(by_number)})"
                 )
-            chosen.append(by_number[int(m)])
-        if not chosen:
-            raise FretdynError(f"{path}: modes is empty: keep at least one mode")
-        if len({s[0] for s in chosen}) != len(chosen):
-            raise FretdynError(f"{path}: modes lists a NUME_ORDRE twice: {list(modes)}")
+            chosen.append(by_number[m])
         steps = chosen
     p = len(steps)
 
@@ -455,8 +561,8 @@ def read_modal_basis(
                 f"with modes=[…]"
             )
     in_file = _parameter(params, "MASS_GENE", steps, path)
-    if generalized_masses is not None:
-        masses = np.asarray(generalized_masses, dtype=float).reshape(-1)
+    if given_masses is not None:
+        masses = given_masses
         if masses.shape != (p,):
             raise FretdynError(
                 f"{path}: generalized_masses has {masses.size} values for the {p} modes kept "
@@ -491,8 +597,7 @@ def read_modal_basis(
             )
     scale = np.sqrt(masses)
 
-    damping = np.asarray(damping_ratio, dtype=float)
-    damping = np.full(p, float(damping)) if damping.ndim == 0 else damping.reshape(-1)
+    damping = np.full(p, float(damping)) if damping.ndim == 0 else damping
     if damping.shape != (p,):
         raise FretdynError(
             f"{path}: damping_ratio has {damping.size} values for the {p} modes kept: give one "

@@ -313,7 +313,10 @@ pub fn percentiles_of_table(table: &Path, request: &PercentileRequest) -> Result
 
 impl PercentileReport {
     /// The report as CSV: the group's columns, then `column, level, n, excluded, estimate,
-    /// ci_low, ci_high, ci_coverage, bootstrap_se` (an empty cell for a missing bound).
+    /// ci_low, ci_high, ci_coverage, bootstrap_se`. A value the samples cannot give (a missing
+    /// bound; the estimate and coverage of no sample; the bootstrap error of fewer than 2) is
+    /// an empty cell, as in the study table (`null` in [`Self::to_json`]; NaN for numpy's
+    /// `genfromtxt` and pandas); an infinite one is `inf`.
     pub fn to_csv(&self) -> String {
         let mut s = String::new();
         let group: Vec<&str> = self
@@ -334,7 +337,14 @@ impl PercentileReport {
             "bootstrap_se",
         ]);
         let _ = writeln!(s, "{}", head.join(","));
-        let opt = |x: Option<f64>| x.map(|x| x.to_string()).unwrap_or_default();
+        let cell = |x: f64| {
+            if x.is_nan() {
+                String::new()
+            } else {
+                x.to_string()
+            }
+        };
+        let opt = |x: Option<f64>| x.map(cell).unwrap_or_default();
         for r in &self.rows {
             let mut cols: Vec<String> = r.group.iter().map(|(_, v)| v.clone()).collect();
             cols.extend([
@@ -342,18 +352,20 @@ impl PercentileReport {
                 r.level.to_string(),
                 r.n.to_string(),
                 r.excluded.to_string(),
-                r.estimate.to_string(),
+                cell(r.estimate),
                 opt(r.ci_low),
                 opt(r.ci_high),
-                r.ci_coverage.to_string(),
-                r.bootstrap_se.to_string(),
+                cell(r.ci_coverage),
+                cell(r.bootstrap_se),
             ]);
             let _ = writeln!(s, "{}", cols.join(","));
         }
         s
     }
 
-    /// The report as JSON (NaN as null).
+    /// The report as JSON: a value the samples cannot give (NaN, a missing bound) is `null`,
+    /// at the places of the empty cells of [`Self::to_csv`] (JSON has no infinity: an
+    /// infinite value is `null` too, `inf` in the CSV).
     pub fn to_json(&self) -> String {
         let rows: Vec<serde_json::Value> = self
             .rows
@@ -413,6 +425,66 @@ mod tests {
         let x = [1.0, f64::INFINITY, f64::INFINITY];
         assert_eq!(quantile(&x, 0.9), f64::INFINITY);
         assert_eq!(quantile(&x, 0.25), f64::INFINITY);
+    }
+
+    #[test]
+    fn what_one_sample_cannot_give_is_an_empty_cell_and_null() {
+        // one completed run and one without a number: P50 of one value has no interval and
+        // no bootstrap error; the group without a value has no estimate either
+        let dir = std::env::temp_dir().join(format!("fretdyn-percentiles-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let table = dir.join("study.csv");
+        std::fs::write(
+            &table,
+            "run,g,status,x\n0,a,completed,2.5\n1,b,completed,\n2,c,completed,inf\n",
+        )
+        .unwrap();
+        let request = PercentileRequest {
+            columns: vec!["x".into()],
+            levels: vec![50.0],
+            group_by: vec!["g".into()],
+            confidence: 0.95,
+            bootstrap: 100,
+            seed: 1,
+        };
+        let r = percentiles_of_table(&table, &request).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
+        let csv = r.to_csv();
+        assert!(!csv.contains("NaN"), "{csv}");
+        assert_eq!(
+            csv,
+            "g,column,level,n,excluded,estimate,ci_low,ci_high,ci_coverage,bootstrap_se\n\
+             a,x,50,1,0,2.5,,,1,\n\
+             b,x,50,0,1,,,,,\n\
+             c,x,50,1,0,inf,,,1,\n"
+        );
+        // null in the JSON where the CSV has an empty cell (and for inf: JSON has none)
+        let json: serde_json::Value = serde_json::from_str(&r.to_json()).unwrap();
+        let keys = [
+            "estimate",
+            "ci_low",
+            "ci_high",
+            "ci_coverage",
+            "bootstrap_se",
+        ];
+        for (row, line) in json["rows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(csv.lines().skip(1))
+        {
+            let cells: Vec<&str> = line.split(',').skip(5).collect();
+            for (k, cell) in keys.iter().zip(cells) {
+                assert_eq!(
+                    row[k].is_null(),
+                    cell.is_empty() || cell == "inf",
+                    "{k}: {line}"
+                );
+                if let Some(x) = row[k].as_f64() {
+                    assert_eq!(cell.parse::<f64>().unwrap(), x, "{k}: {line}");
+                }
+            }
+        }
     }
 
     #[test]
