@@ -376,7 +376,8 @@ impl CaseFile {
                 return Err(Error::invalid(
                     format!("{field}.span"),
                     format!(
-                        "must be [s0, s1] with 0 ≤ s0 < s1 ≤ {length} m (the tube's length along its axis)"
+                        "must be [s0, s1] with 0 ≤ s0 < s1 ≤ {} m (the tube's length along its axis)",
+                        number(length)
                     ),
                 ));
             }

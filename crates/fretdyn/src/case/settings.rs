@@ -226,14 +226,17 @@ impl CaseFile {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::invalid(
                 "time.dt",
-                format!("must be a positive time step in s (got {dt})"),
+                format!("must be a positive time step in s (got {})", number(dt)),
             ));
         }
         let duration = self.time.duration;
         if !(duration.is_finite() && duration > 0.0) {
             return Err(Error::invalid(
                 "time.duration",
-                format!("must be a positive duration in s (got {duration})"),
+                format!(
+                    "must be a positive duration in s (got {})",
+                    number(duration)
+                ),
             ));
         }
         if duration < dt * (1.0 - 1e-9) {
@@ -283,7 +286,11 @@ impl CaseFile {
         if steps > 1e12 {
             return Err(Error::invalid(
                 "time.duration",
-                format!("gives {steps:e} steps of {dt} s: more than 1e12 steps"),
+                format!(
+                    "gives {} steps of {} s: more than 1e12 steps",
+                    number(steps),
+                    number(dt)
+                ),
             ));
         }
         let settings = RunSettings {
