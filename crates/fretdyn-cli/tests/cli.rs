@@ -1440,3 +1440,16 @@ fn an_implausible_value_is_a_one_line_warning_naming_the_file_and_the_key() {
         "{stderr}"
     );
 }
+
+/// A turbulence band limit above 1/(2Δt) ran for hours: refused at once, with the limit.
+#[test]
+fn a_turbulence_band_limit_above_nyquist_is_refused_at_once() {
+    let text = std::fs::read_to_string(examples().join("tube_turbulence.toml")).unwrap();
+    let case = text.replace("f_max = 250.0", "f_max = 1e9");
+    assert_ne!(case, text);
+    assert_refused(
+        "f_max",
+        &[("turbulence.toml", &case)],
+        &["turbulence[0].f_max", "Nyquist", "set f_max ≤ 50000 Hz"],
+    );
+}

@@ -980,3 +980,63 @@ fn a_warning_names_the_case_file() {
         case.warnings[0]
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// Sizes derived from user numbers: turbulence band limit, contacts' memory (issue [3.1])
+// ---------------------------------------------------------------------------------------------
+
+const TURBULENCE: &str = include_str!("../../../examples/tube_turbulence.toml");
+
+/// A band limit above the Nyquist frequency ran for hours (1e9 Hz: thousands of samples per
+/// step) or never ended (9.2e18 Hz); refused with 1/(2Δt).
+#[test]
+fn a_turbulence_band_limit_above_the_nyquist_frequency_is_refused() {
+    // Δt = 1e-5 s: 1/(2Δt) = 50 kHz
+    for f_max in ["1e9", "9.2e18", "50001"] {
+        let text = replace_once(TURBULENCE, "f_max = 250.0", &format!("f_max = {f_max}"));
+        let (field, message) = invalid_in(&text, &examples_dir());
+        assert_eq!(field, "turbulence[0].f_max");
+        assert!(
+            message.contains("Nyquist")
+                && message.contains("50000 Hz")
+                && message.contains("set f_max ≤ 50000 Hz"),
+            "{message}"
+        );
+    }
+    // the Nyquist frequency itself is a band limit
+    let text = replace_once(TURBULENCE, "f_max = 250.0", "f_max = 5e4");
+    assert!(Case::from_toml_str(&text, &examples_dir()).is_ok());
+}
+
+/// V1a's contact 20 000 times (each an unnamed plane): the Lagrange methods' dense matrices
+/// of the 40 000 tangential unknowns (3 of 12.8 GB) aborted the run on their allocation;
+/// the case is refused with the figure and the fix (unless this machine has the memory).
+#[test]
+fn contacts_whose_memory_is_not_available_are_refused_with_the_figure() {
+    let contact = "[[contacts]]\npoint = \"mass\"\nobstacle = { type = \"plane\", normal = [0.0, 0.0, 1.0] }\nnormal = { stiffness = 1e6 }\nfriction = { mu = 0.3 }\n";
+    let start = V1A.find("[[contacts]]").unwrap();
+    let end = V1A.find("[tangential]").unwrap();
+    let text = format!("{}{}{}", &V1A[..start], contact.repeat(20_000), &V1A[end..]);
+    // 3 (2m)² matrices of 8 bytes at least
+    let needed = 3.0 * 8.0 * 4e4 * 4e4;
+    if needed <= fretdyn::structure::beam::available_memory() {
+        eprintln!("skipped: this machine has {needed:e} bytes available");
+        return;
+    }
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "contacts");
+    assert!(
+        message.contains("20000 contacts")
+            && message.contains("GB")
+            && message.contains("use fewer contacts")
+            && message.contains("\"penalty\""),
+        "{message}"
+    );
+    // the penalty method's memory grows as contacts × modes: it fits
+    let penalty = replace_once(
+        &text,
+        "method = \"gauss_seidel\"",
+        "method = \"penalty\"\npenalty = { stiffness = 1e6 }",
+    );
+    assert!(Case::from_toml_str(&penalty, Path::new(".")).is_ok());
+}

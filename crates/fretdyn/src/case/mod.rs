@@ -22,6 +22,7 @@ mod flow;
 pub mod key_path;
 mod life;
 mod loads;
+pub mod memory;
 mod messages;
 mod quantities;
 mod settings;

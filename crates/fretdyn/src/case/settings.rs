@@ -55,7 +55,7 @@ fn default_max_relative_error() -> f64 {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct TimeSection {
-    dt: f64,
+    pub(super) dt: f64,
     duration: f64,
 }
 
@@ -327,6 +327,9 @@ impl CaseFile {
                 ),
             ));
         }
+        // contacts and turbulence that would not fit in memory: refused with the figure
+        // before the run allocates them
+        super::memory::check(model, &settings.method)?;
         // a model without a usable stable time step (a unit slip: a mass of 1e-320 kg, a
         // radius of 1e200 m) is refused here, naming its cause; a Δt above a usable limit is
         // left to the run, which says the limit
