@@ -1453,3 +1453,65 @@ fn a_turbulence_band_limit_above_nyquist_is_refused_at_once() {
         &["turbulence[0].f_max", "Nyquist", "set f_max ≤ 50000 Hz"],
     );
 }
+
+/// A real full disk while writing results.nc (a small tmpfs; needs the right to mount,
+/// skipped without it): the netCDF library's "NetCDF: HDF error" is said as the disk being
+/// full, with what stays written and `--resume`, which finishes the run once there is room.
+#[test]
+fn a_full_disk_while_writing_results_nc_says_so_and_is_resumed() {
+    let s = Scratch::new("tmpfs_nc");
+    let v1a = examples().join("v1a_oblique_impact.toml");
+    let v1a = v1a.to_str().unwrap();
+    let out = fretdyn(&["run", v1a, "-o", "full", "-q", "--no-plots"], &s.0);
+    assert!(out.status.success());
+    let disk = s.0.join("disk");
+    std::fs::create_dir_all(&disk).unwrap();
+    // the series (about 490 kB) and results.npz (as much) fit, results.nc does not
+    let mounted = Command::new("mount")
+        .args([
+            "-t",
+            "tmpfs",
+            "-o",
+            "size=1100k",
+            "tmpfs",
+            disk.to_str().unwrap(),
+        ])
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !mounted {
+        eprintln!("skipped: cannot mount a tmpfs here");
+        return;
+    }
+    struct Unmount(PathBuf);
+    impl Drop for Unmount {
+        fn drop(&mut self) {
+            let _ = Command::new("umount").arg(&self.0).status();
+        }
+    }
+    let _unmount = Unmount(disk.clone());
+    let out = fretdyn(&["run", v1a, "-o", "disk/out", "-q", "--no-plots"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let error = stderr
+        .lines()
+        .find(|l| l.starts_with("error: "))
+        .unwrap_or_else(|| panic!("no error in: {stderr}"));
+    for needle in [
+        "results.nc: No space left on device",
+        "results.npz and the time histories in series/ stay written",
+        "fretdyn run --resume disk/out",
+    ] {
+        assert!(error.contains(needle), "{needle}: {stderr}");
+    }
+    assert!(!stderr.contains("HDF error"), "{stderr}");
+    assert!(s.0.join("disk/out/results.npz").exists());
+    assert!(!s.0.join("disk/out/results.nc").exists());
+    let remount = Command::new("mount")
+        .args(["-o", "remount,size=4m", disk.to_str().unwrap()])
+        .status()
+        .unwrap();
+    assert!(remount.success());
+    resumed_equals(&s.0, "disk/out", &s.0.join("full"));
+    assert!(s.0.join("disk/out/results.nc").exists());
+}
