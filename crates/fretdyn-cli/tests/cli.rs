@@ -146,7 +146,11 @@ fn non_finite_mode_shape() {
 #[test]
 fn unknown_key() {
     let case = V1A.replace("duration = 4e-3", "duration = 4e-3\nstep = 2");
-    assert_input_error("key", &case, &["line 18", "unknown field `step`", "dt"]);
+    assert_input_error(
+        "key",
+        &case,
+        &["line 18", "time.step: unknown key", "dt, duration"],
+    );
 }
 
 #[test]
@@ -185,7 +189,8 @@ fn divergence_stops_with_the_step_and_keeps_results() {
     let s = Scratch::new("diverge");
     let case = V1A.replace(
         "[output]",
-        "[[loads]]\npoint = \"mass\"\nforce = [0.0, 1e307, 0.0]\n\n[output]",
+        // a force growing to 1e307 N (a load that large is refused: the history is not)
+        "[[loads]]\npoint = \"mass\"\nforce = [0.0, 1.0, 0.0]\nhistory = { type = \"table\", table = [[0.0, 0.0], [2e-3, 1e307]] }\n\n[output]",
     );
     std::fs::write(s.0.join("case.toml"), case).unwrap();
     let out = fretdyn(&["run", "case.toml", "-o", "out", "--quiet"], &s.0);
@@ -1338,4 +1343,175 @@ fn bench_pair_reports_b_over_a() {
     let costly = "ubend_flow.toml";
     assert!(ratio(cheap, costly) < 0.5);
     assert!(ratio(costly, cheap) > 2.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue [3.1]: schema errors in plain words, plausibility warnings, results.nc on a full disk
+// ---------------------------------------------------------------------------------------------
+
+/// The catalogue's schema errors on the command line: one line naming the file and the key
+/// as written, in plain words (they were serde's: `invalid value: integer `-1`, expected
+/// u64`, `invalid type: integer `1`, expected a boolean`), exit code 2.
+#[test]
+fn schema_errors_name_the_file_and_the_key_in_plain_words() {
+    let serde = [
+        "invalid type",
+        "invalid value",
+        "expected usize",
+        "expected u64",
+        "expected f64",
+        "expected a boolean",
+        "integer `",
+        "floating point `",
+        "unknown field",
+        "unknown variant",
+    ];
+    for (name, from, to, needles) in [
+        (
+            "every",
+            "every = 1 ",
+            "every = -1 ",
+            &["output.every: must be a whole number ≥ 1", "got -1"][..],
+        ),
+        (
+            "warm_start",
+            "warm_start = true",
+            "warm_start = 1",
+            &["tangential.gauss_seidel.warm_start: must be true or false, got 1"],
+        ),
+        (
+            "max_sweeps",
+            "max_sweeps = 1000",
+            "max_sweeps = -1",
+            &[
+                "tangential.gauss_seidel.max_sweeps: must be a whole number ≥ 1",
+                "got -1",
+            ],
+        ),
+        (
+            "mu",
+            "friction = { mu = 0.3 }",
+            "friction = { mu = \"0.3\" }",
+            &["contacts[0].friction.mu: must be a number", "got \"0.3\""],
+        ),
+        (
+            "position",
+            "position = [0.0, 0.0, 0.0]",
+            "position = [0.0, 0.0]",
+            &[
+                "structure.position: must be a list of 3 values",
+                "got [0.0, 0.0]",
+            ],
+        ),
+    ] {
+        let case = V1A.replace(from, to);
+        assert_ne!(case, V1A);
+        let s = Scratch::new(&format!("words_{name}"));
+        std::fs::write(s.0.join("case.toml"), &case).unwrap();
+        let out = fretdyn(&["run", "case.toml", "-o", "out"], &s.0);
+        assert_one_line_error(&out, 2, needles);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.starts_with("error: case.toml: line "), "{stderr}");
+        for w in serde {
+            assert!(!stderr.contains(w), "{name}: serde's '{w}' in: {stderr}");
+        }
+        assert!(!s.0.join("out").exists(), "{name}: output written");
+    }
+}
+
+/// A value no structure has (μ = 1e6) is one warning line naming the file, the key, the
+/// value and the plausible range; the run goes on.
+#[test]
+fn an_implausible_value_is_a_one_line_warning_naming_the_file_and_the_key() {
+    let s = Scratch::new("implausible");
+    std::fs::write(
+        s.0.join("case.toml"),
+        V1A.replace("friction = { mu = 0.3 }", "friction = { mu = 1e6 }"),
+    )
+    .unwrap();
+    let out = fretdyn(&["run", "case.toml", "-o", "out", "-q", "--no-plots"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let warnings: Vec<&str> = stderr.lines().filter(|l| l.contains("friction")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(
+        warnings[0].starts_with("warning: case.toml: contacts[0].friction.mu = 1e6 ")
+            && warnings[0].contains("0 to 2"),
+        "{stderr}"
+    );
+}
+
+/// A turbulence band limit above 1/(2Δt) ran for hours: refused at once, with the limit.
+#[test]
+fn a_turbulence_band_limit_above_nyquist_is_refused_at_once() {
+    let text = std::fs::read_to_string(examples().join("tube_turbulence.toml")).unwrap();
+    let case = text.replace("f_max = 250.0", "f_max = 1e9");
+    assert_ne!(case, text);
+    assert_refused(
+        "f_max",
+        &[("turbulence.toml", &case)],
+        &["turbulence[0].f_max", "Nyquist", "set f_max ≤ 50000 Hz"],
+    );
+}
+
+/// A real full disk while writing results.nc (a small tmpfs; needs the right to mount,
+/// skipped without it): the netCDF library's "NetCDF: HDF error" is said as the disk being
+/// full, with what stays written and `--resume`, which finishes the run once there is room.
+#[test]
+fn a_full_disk_while_writing_results_nc_says_so_and_is_resumed() {
+    let s = Scratch::new("tmpfs_nc");
+    let v1a = examples().join("v1a_oblique_impact.toml");
+    let v1a = v1a.to_str().unwrap();
+    let out = fretdyn(&["run", v1a, "-o", "full", "-q", "--no-plots"], &s.0);
+    assert!(out.status.success());
+    let disk = s.0.join("disk");
+    std::fs::create_dir_all(&disk).unwrap();
+    // the series (about 490 kB) and results.npz (as much) fit, results.nc does not
+    let mounted = Command::new("mount")
+        .args([
+            "-t",
+            "tmpfs",
+            "-o",
+            "size=1100k",
+            "tmpfs",
+            disk.to_str().unwrap(),
+        ])
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !mounted {
+        eprintln!("skipped: cannot mount a tmpfs here");
+        return;
+    }
+    struct Unmount(PathBuf);
+    impl Drop for Unmount {
+        fn drop(&mut self) {
+            let _ = Command::new("umount").arg(&self.0).status();
+        }
+    }
+    let _unmount = Unmount(disk.clone());
+    let out = fretdyn(&["run", v1a, "-o", "disk/out", "-q", "--no-plots"], &s.0);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let error = stderr
+        .lines()
+        .find(|l| l.starts_with("error: "))
+        .unwrap_or_else(|| panic!("no error in: {stderr}"));
+    for needle in [
+        "results.nc: No space left on device",
+        "results.npz and the time histories in series/ stay written",
+        "fretdyn run --resume disk/out",
+    ] {
+        assert!(error.contains(needle), "{needle}: {stderr}");
+    }
+    assert!(!stderr.contains("HDF error"), "{stderr}");
+    assert!(s.0.join("disk/out/results.npz").exists());
+    assert!(!s.0.join("disk/out/results.nc").exists());
+    let remount = Command::new("mount")
+        .args(["-o", "remount,size=4m", disk.to_str().unwrap()])
+        .status()
+        .unwrap();
+    assert!(remount.success());
+    resumed_equals(&s.0, "disk/out", &s.0.join("full"));
+    assert!(s.0.join("disk/out/results.nc").exists());
 }

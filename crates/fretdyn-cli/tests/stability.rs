@@ -169,7 +169,7 @@ fn stability_bad_input_is_one_line_naming_file_and_field() {
         (
             "pattern = \"in_line_square\"",
             "pattern = \"hexagonal\"",
-            "line 32, column 11: unknown variant `hexagonal`",
+            "line 32, column 11: flow.pattern: must be one of",
         ),
     ] {
         let text = good.replace(from, to);

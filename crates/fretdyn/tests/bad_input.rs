@@ -592,3 +592,451 @@ fn an_initial_state_whose_energy_overflows_is_refused() {
         other => panic!("expected a refusal, got {:?}", other.map(|r| r.termination)),
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Schema errors in a person's words (issue [3.1])
+// ---------------------------------------------------------------------------------------------
+
+/// serde's words, which a schema error no longer shows.
+const SERDE_WORDS: &[&str] = &[
+    "invalid type",
+    "invalid value",
+    "invalid length",
+    "expected usize",
+    "expected u64",
+    "expected u32",
+    "expected f64",
+    "expected a boolean",
+    "expected a string",
+    "expected struct",
+    "expected internally tagged",
+    "integer `",
+    "floating point `",
+    "boolean `",
+    "unknown field",
+    "unknown variant",
+    "missing field",
+    "untagged enum",
+    "wanted string or table",
+];
+
+/// The key and the message of the schema error `text` gives, and the error as displayed.
+fn schema_error(text: &str) -> (Option<String>, String, String) {
+    match Case::from_toml_str(text, Path::new(".")) {
+        Err(e @ Error::Parse { .. }) => {
+            let Error::Parse { message, .. } = &e else {
+                unreachable!()
+            };
+            (
+                e.field().map(str::to_string),
+                message.clone(),
+                e.to_string(),
+            )
+        }
+        Err(e) => panic!("expected a schema error, got {e:?}"),
+        Ok(_) => panic!("expected an error"),
+    }
+}
+
+/// The catalogue of bad inputs: each schema error names the key as written and says what
+/// is expected in plain words, with the value as written (the messages were serde's:
+/// `invalid value: integer `-1`, expected u64`, `invalid type: integer `1`, expected a
+/// boolean`, at a line and column only).
+#[test]
+fn schema_errors_name_the_key_and_say_what_is_expected_in_plain_words() {
+    let cases: &[(&str, &str, &str, &str, &[&str])] = &[
+        (
+            V1A,
+            "every = 1 ",
+            "every = -1 ",
+            "output.every",
+            &["a whole number ≥ 1", "got -1"],
+        ),
+        (
+            V1A,
+            "every = 1 ",
+            "every = 2.5 ",
+            "output.every",
+            &["whole number", "got 2.5"],
+        ),
+        (
+            V1A,
+            "warm_start = true",
+            "warm_start = 1",
+            "tangential.gauss_seidel.warm_start",
+            &["true or false", "got 1"],
+        ),
+        (
+            V1A,
+            "max_sweeps = 1000",
+            "max_sweeps = 1.5",
+            "tangential.gauss_seidel.max_sweeps",
+            &["a whole number ≥ 1", "got 1.5"],
+        ),
+        (
+            V1A,
+            "max_iterations = 50",
+            "max_iterations = -5",
+            "tangential.active_set.max_iterations",
+            &["a whole number ≥ 1", "got -5"],
+        ),
+        (
+            V1A,
+            "dt = 1e-6",
+            "dt = \"small\"",
+            "time.dt",
+            &["a number", "s)", "got \"small\""],
+        ),
+        (
+            V1A,
+            "method = \"gauss_seidel\"",
+            "method = \"newton\"",
+            "tangential.method",
+            &[
+                "one of \"penalty\", \"active_set\", \"gauss_seidel\"",
+                "got \"newton\"",
+            ],
+        ),
+        (
+            V1A,
+            "stick_velocity = \"half_step\"",
+            "stick_velocity = 3",
+            "tangential.stick_velocity",
+            &["a name in double quotes", "got 3"],
+        ),
+        // inside a tagged table ([structure], an obstacle): the value below it
+        (
+            V1A,
+            "position = [0.0, 0.0, 0.0]",
+            "position = [0.0, 0.0]",
+            "structure.position",
+            &["a list of 3 values", "got [0.0, 0.0]"],
+        ),
+        (
+            V1A,
+            "normal = [0.0, 0.0, 1.0], gap",
+            "normal = [0.0, 0.0, \"z\"], gap",
+            "contacts[0].obstacle.normal[2]",
+            &["a number", "got \"z\""],
+        ),
+        (
+            V1A,
+            "gap = 0.0, tangent",
+            "gap = \"0\", tangent",
+            "contacts[0].obstacle.gap",
+            &["a number (a gap in m)", "got \"0\""],
+        ),
+        (
+            V1A,
+            "type = \"plane\", origin",
+            "type = \"plan\", origin",
+            "contacts[0].obstacle.type",
+            &[
+                "one of \"plane\", \"circle\", \"bi_plane\", \"polygon\"",
+                "got \"plan\"",
+            ],
+        ),
+        (
+            V1A,
+            "type = \"plane\", origin",
+            "origin",
+            "contacts[0].obstacle.type",
+            &["is missing", "add type"],
+        ),
+        (
+            V1A,
+            "friction = { mu = 0.3 }",
+            "friction = { mu = true }",
+            "contacts[0].friction.mu",
+            &["a number (a friction coefficient)", "got true"],
+        ),
+        (
+            V1A,
+            "friction = { mu = 0.3 }",
+            "friction = 0.3",
+            "contacts[0].friction",
+            &["a table", "got 0.3"],
+        ),
+        (
+            V1A,
+            "velocity = [0.3420201433256687, 0.0, -0.9396926207859084]",
+            "velocity = [0.34, 0.0, \"x\"]",
+            "initial.velocity[2]",
+            &["a number (a velocity in m/s)", "got \"x\""],
+        ),
+        (V1A, "dt = 1e-6", "", "time.dt", &["is missing", "[time]"]),
+        (
+            V1A,
+            "duration = 4e-3",
+            "duraton = 4e-3",
+            "time.duraton",
+            &["unknown key", "dt, duration"],
+        ),
+        (
+            V1A,
+            "name = \"plane\"",
+            "nam = \"plane\"",
+            "contacts[0].nam",
+            &["unknown key", "name"],
+        ),
+        (
+            TUBE,
+            "damping_ratio = 0.01",
+            "damping_ratio = \"1 %\"",
+            "structure.damping_ratio",
+            &["a damping ratio", "one per mode", "got \"1 %\""],
+        ),
+        (
+            TUBE,
+            "modes = 12",
+            "modes = -12",
+            "structure.modes",
+            &["a whole number ≥ 1", "got -12"],
+        ),
+    ];
+    for (base, from, to, key, needles) in cases {
+        let text = replace_once(base, from, to);
+        let (found, message, display) = schema_error(&text);
+        assert_eq!(found.as_deref(), Some(*key), "{to}: {display}");
+        assert!(display.contains(&format!(": {key}: ")), "{display}");
+        for n in *needles {
+            assert!(message.contains(n), "{to}: '{n}' not in: {message}");
+        }
+        for w in SERDE_WORDS {
+            assert!(!display.contains(w), "{to}: serde's '{w}' in: {display}");
+        }
+    }
+}
+
+/// A study file's schema errors, and its base case's, are worded the same way.
+#[test]
+fn study_schema_errors_name_the_key_in_plain_words() {
+    let (_dir, path) = study_dir(
+        "study_words",
+        "base = \"v1a.toml\"\nruns = 3\n\n[[parameters]]\nkey = \"time.dt\"\nvalues = [1e-6]\n",
+    );
+    let err = Study::from_file(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("runs: unknown key") && err.contains("parameters"),
+        "{err}"
+    );
+    let (dir, path) = study_dir("study_base_words", "base = \"v1a.toml\"\n");
+    std::fs::write(
+        dir.0.join("v1a.toml"),
+        replace_once(V1A, "every = 1 ", "every = -1 "),
+    )
+    .unwrap();
+    let err = Study::from_file(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("output.every: must be a whole number ≥ 1") && err.contains("got -1"),
+        "{err}"
+    );
+    for w in SERDE_WORDS {
+        assert!(!err.contains(w), "serde's '{w}' in: {err}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Plausibility: finite but absurd values (issue [3.1])
+// ---------------------------------------------------------------------------------------------
+
+const MULTISPAN: &str = include_str!("../../../examples/tube_multispan.toml");
+const LIFE: &str = include_str!("../../../examples/tube_multispan_life.toml");
+
+fn examples_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
+}
+
+/// The warnings of the case `text` (which builds).
+fn warnings_of(text: &str) -> Vec<String> {
+    match Case::from_toml_str(text, &examples_dir()) {
+        Ok(case) => case.warnings,
+        Err(e) => panic!("expected a case with warnings, got {e}"),
+    }
+}
+
+/// The catalogue's absurd values, each accepted before without a word: a warning naming the
+/// key as written, the value and the plausible range, or a refusal when no computation can
+/// be made with it.
+#[test]
+fn absurd_values_warn_or_are_refused() {
+    let load = |force: &str| {
+        replace_once(
+            V1A,
+            "[tangential]\n",
+            &format!("[[loads]]\npoint = \"mass\"\nforce = [0.0, {force}, 0.0]\n\n[tangential]\n"),
+        )
+    };
+    let first = |text: &str, from: &str, to: &str| text.replacen(from, to, 1);
+    let warned = [
+        (load("1e9"), "loads[0].force[1] = 1e9 N", "-1e7 to 1e7 N"),
+        (
+            replace_once(V1A, "friction = { mu = 0.3 }", "friction = { mu = 1e6 }"),
+            "contacts[0].friction.mu = 1e6 ",
+            "friction coefficient, 0 to 2",
+        ),
+        (
+            first(MULTISPAN, "clearance = 2e-4", "clearance = 1e3"),
+            "contacts[0].obstacle.clearance = 1000 m",
+            "0 to 0.1 m",
+        ),
+        (
+            replace_once(TUBE, "density = 8200.0", "density = 8.2"),
+            "structure.density = 8.2 kg/m³",
+            "1000 to 25000 kg/m³",
+        ),
+        (
+            first(LIFE, "thickness = 0.02", "thickness = 1e3"),
+            "contacts[0].wear.scar.thickness = 1000 m",
+            "0.0001 to 0.5 m",
+        ),
+    ];
+    for (text, value, range) in warned {
+        let warnings = warnings_of(&text);
+        let w = warnings
+            .iter()
+            .find(|w| w.contains(value))
+            .unwrap_or_else(|| panic!("no warning with '{value}': {warnings:?}"));
+        assert!(
+            w.contains(range) && w.contains("unit") && !w.contains('\n'),
+            "{w}"
+        );
+    }
+    // a load of 1e150 N: the energies and statistics the run sums from its square overflow
+    // (a gap of 1e300 m: the run "diverged" at its first step)
+    for (text, key, value) in [
+        (load("1e150"), "loads[0].force[1]", "1e150 N"),
+        (load("-1e300"), "loads[0].force[1]", "-1e300 N"),
+        (
+            replace_once(V1A, "gap = 0.0, tangent", "gap = 1e300, tangent"),
+            "contacts[0].obstacle.gap",
+            "1e300 m",
+        ),
+    ] {
+        let (field, message) = invalid(&text);
+        assert_eq!(field, key);
+        assert!(
+            message.contains(value) && message.contains("1e100") && message.contains("overflow"),
+            "{message}"
+        );
+    }
+    // a wear exponent of 1e300: every power of the work rate overflows or vanishes
+    let text = first(
+        LIFE,
+        "tube = { law = \"archard\", coefficient = 6.0e-17 }",
+        "tube = { law = \"decaying\", a = 1e-12, b = 1e300, s = 0.5, n = 1e-6 }",
+    );
+    let (field, message) = invalid_in(&text, &examples_dir());
+    assert_eq!(field, "contacts[0].wear.tube.b");
+    assert!(
+        message.contains("1e300") && message.contains("-30 to 30") && message.contains("overflow"),
+        "{message}"
+    );
+    // a plausible exponent is accepted without a word
+    let text = text.replace("b = 1e300", "b = 1.2");
+    assert!(warnings_of(&text).is_empty());
+}
+
+/// The shipped examples are plausible: no warning at all.
+#[test]
+fn the_examples_give_no_warning() {
+    let mut cases = 0;
+    for entry in std::fs::read_dir(examples_dir()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        if text.lines().any(|l| l.starts_with("base = ")) {
+            continue; // a study
+        }
+        let case = Case::from_file(&path).unwrap();
+        assert!(
+            case.warnings.is_empty(),
+            "{}: {:?}",
+            path.display(),
+            case.warnings
+        );
+        cases += 1;
+    }
+    assert!(cases >= 10, "{cases} example cases");
+}
+
+/// A warning of a case file names the file.
+#[test]
+fn a_warning_names_the_case_file() {
+    let dir = TempDir::new("warning_file");
+    let path = dir.0.join("dense.toml");
+    std::fs::write(
+        &path,
+        replace_once(TUBE, "density = 8200.0", "density = 8.2"),
+    )
+    .unwrap();
+    let case = Case::from_file(&path).unwrap();
+    assert_eq!(case.warnings.len(), 1, "{:?}", case.warnings);
+    assert!(
+        case.warnings[0].starts_with(&format!("{}: structure.density = 8.2", path.display())),
+        "{}",
+        case.warnings[0]
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sizes derived from user numbers: turbulence band limit, contacts' memory (issue [3.1])
+// ---------------------------------------------------------------------------------------------
+
+const TURBULENCE: &str = include_str!("../../../examples/tube_turbulence.toml");
+
+/// A band limit above the Nyquist frequency ran for hours (1e9 Hz: thousands of samples per
+/// step) or never ended (9.2e18 Hz); refused with 1/(2Δt).
+#[test]
+fn a_turbulence_band_limit_above_the_nyquist_frequency_is_refused() {
+    // Δt = 1e-5 s: 1/(2Δt) = 50 kHz
+    for f_max in ["1e9", "9.2e18", "50001"] {
+        let text = replace_once(TURBULENCE, "f_max = 250.0", &format!("f_max = {f_max}"));
+        let (field, message) = invalid_in(&text, &examples_dir());
+        assert_eq!(field, "turbulence[0].f_max");
+        assert!(
+            message.contains("Nyquist")
+                && message.contains("50000 Hz")
+                && message.contains("set f_max ≤ 50000 Hz"),
+            "{message}"
+        );
+    }
+    // the Nyquist frequency itself is a band limit
+    let text = replace_once(TURBULENCE, "f_max = 250.0", "f_max = 5e4");
+    assert!(Case::from_toml_str(&text, &examples_dir()).is_ok());
+}
+
+/// V1a's contact 20 000 times (each an unnamed plane): the Lagrange methods' dense matrices
+/// of the 40 000 tangential unknowns (3 of 12.8 GB) aborted the run on their allocation;
+/// the case is refused with the figure and the fix (unless this machine has the memory).
+#[test]
+fn contacts_whose_memory_is_not_available_are_refused_with_the_figure() {
+    let contact = "[[contacts]]\npoint = \"mass\"\nobstacle = { type = \"plane\", normal = [0.0, 0.0, 1.0] }\nnormal = { stiffness = 1e6 }\nfriction = { mu = 0.3 }\n";
+    let start = V1A.find("[[contacts]]").unwrap();
+    let end = V1A.find("[tangential]").unwrap();
+    let text = format!("{}{}{}", &V1A[..start], contact.repeat(20_000), &V1A[end..]);
+    // 3 (2m)² matrices of 8 bytes at least
+    let needed = 3.0 * 8.0 * 4e4 * 4e4;
+    if needed <= fretdyn::structure::beam::available_memory() {
+        eprintln!("skipped: this machine has {needed:e} bytes available");
+        return;
+    }
+    let (field, message) = invalid(&text);
+    assert_eq!(field, "contacts");
+    assert!(
+        message.contains("20000 contacts")
+            && message.contains("GB")
+            && message.contains("use fewer contacts")
+            && message.contains("\"penalty\""),
+        "{message}"
+    );
+    // the penalty method's memory grows as contacts × modes: it fits
+    let penalty = replace_once(
+        &text,
+        "method = \"gauss_seidel\"",
+        "method = \"penalty\"\npenalty = { stiffness = 1e6 }",
+    );
+    assert!(Case::from_toml_str(&penalty, Path::new(".")).is_ok());
+}

@@ -218,7 +218,8 @@ fn unknown_key_is_a_parse_error_with_its_line() {
                 unreachable!()
             };
             assert_eq!(*l, line, "{e}");
-            assert!(message.contains("durration"), "{message}");
+            assert_eq!(e.field(), Some("time.durration"), "{e}");
+            assert!(message.contains("unknown key"), "{message}");
             assert!(e.to_string().starts_with(&format!("line {line},")), "{e}");
         }
         other => panic!("expected Error::Parse, got {other:?}"),

@@ -122,6 +122,9 @@ impl CaseFile {
     /// `[[contacts]]`: each contact's point, obstacle (and its motion), normal law and
     /// friction coefficients (THEORY §3, §4, §7, §8).
     pub(super) fn build_contacts(&self, tube: Option<&TubeModel>, model: &mut Model) -> Result<()> {
+        // the index of each name given so far (a search per contact was O(m²): minutes for
+        // 100 000 contacts)
+        let mut names = std::collections::HashMap::with_capacity(self.contacts.len());
         for (k, c) in self.contacts.iter().enumerate() {
             let field = format!("contacts[{k}]");
             let pt = point_index(&c.point, format!("{field}.point"), model)?;
@@ -223,7 +226,7 @@ impl CaseFile {
                 (e, _) => e,
             })?;
             let name = c.name.clone().unwrap_or_else(|| format!("contact{k}"));
-            if let Some(j) = model.contacts.iter().position(|o| o.name == name) {
+            if let Some(j) = names.insert(name.clone(), k) {
                 return Err(Error::invalid(
                     format!("{field}.name"),
                     format!(

@@ -57,7 +57,10 @@ impl LifeSection {
                 if !(f.is_finite() && f > 0.0 && f <= 1.0) {
                     return Err(Error::invalid(
                         "life.criterion_wall_fraction",
-                        format!("must be a fraction of the wall in (0, 1] (got {f}), e.g. 0.4"),
+                        format!(
+                            "must be a fraction of the wall in (0, 1] (got {}), e.g. 0.4",
+                            crate::error::number(f)
+                        ),
                     ));
                 }
                 let tube = tube.ok_or_else(|| {

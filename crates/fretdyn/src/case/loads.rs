@@ -330,6 +330,33 @@ fn read_table(path: &Path, field: &str) -> Result<Vec<[f64; 2]>> {
     Ok(rows.into_iter().map(|(r, _)| r).collect())
 }
 
+/// Refuses a band limit above the Nyquist frequency `1/(2Δt)` of the time step (when Δt is
+/// a valid step; its own errors come first). The signals are read once a step: power above
+/// `1/(2Δt)` would fold into the band below it, and the generator would compute thousands of
+/// samples per step (a run of hours for `f_max = 1e9` Hz at Δt = 1e-5 s). It is refused rather
+/// than capped: a cap would change the load (its variance `∫₀^{f_max} S df`) without the case
+/// saying so, and a study varying `time.dt` would vary the load with it.
+fn check_band_limit(f_max: f64, dt: f64, field: &str) -> Result<()> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Ok(());
+    }
+    let nyquist = 0.5 / dt;
+    // (0.5 / 1e-5 is 49999.999999999993: the Nyquist frequency as written is allowed)
+    if f_max > nyquist * (1.0 + 1e-12) {
+        return Err(Error::invalid(
+            format!("{field}.f_max"),
+            format!(
+                "{} Hz is above the Nyquist frequency 1/(2 time.dt) = {} Hz of the time step (time.dt = {} s): the forces are sampled once a step, so they cannot carry power above it; set f_max ≤ {} Hz (a few times the highest frequency of interest is enough), or a smaller time.dt",
+                number(f_max),
+                number(nyquist),
+                number(dt),
+                number(nyquist)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 impl CaseFile {
     /// `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]`, `[[turbulence]]` and
     /// `[base_excitation]`, projected on the modes (THEORY §8, §10).
@@ -376,7 +403,8 @@ impl CaseFile {
                 return Err(Error::invalid(
                     format!("{field}.span"),
                     format!(
-                        "must be [s0, s1] with 0 ≤ s0 < s1 ≤ {length} m (the tube's length along its axis)"
+                        "must be [s0, s1] with 0 ≤ s0 < s1 ≤ {} m (the tube's length along its axis)",
+                        number(length)
                     ),
                 ));
             }
@@ -484,6 +512,7 @@ impl CaseFile {
                 f_max: l.f_max,
             };
             load.validate(modes, &field)?;
+            check_band_limit(l.f_max, self.time.dt, &field)?;
             model.turbulence.push(load);
         }
         if let Some(b) = &self.base_excitation {

@@ -23,6 +23,9 @@ mod flow;
 pub mod key_path;
 mod life;
 mod loads;
+pub mod memory;
+mod messages;
+mod quantities;
 mod settings;
 mod structure;
 mod wear;
@@ -78,7 +81,7 @@ impl Case {
     pub fn from_file(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let base = path.parent().unwrap_or(Path::new("."));
-        let mut case = Self::from_toml_str(&text, base)?;
+        let mut case = Self::from_toml_in(&text, base, Some(path))?;
         if case.title.is_empty() {
             case.title = path
                 .file_stem()
@@ -90,11 +93,24 @@ impl Case {
 
     /// Parses a case from TOML text; `base` resolves relative file names.
     pub fn from_toml_str(text: &str, base: &Path) -> Result<Self> {
-        let (echo_value, file) = read_case_file(text)?;
+        Self::from_toml_in(text, base, None)
+    }
+
+    /// [`Self::from_toml_str`] of the text of the case file at `path` when there is one (the
+    /// warnings about its values name it).
+    fn from_toml_in(text: &str, base: &Path, path: Option<&Path>) -> Result<Self> {
+        let (echo_value, mut file) = read_case_file(text)?;
+        // values no tube, support or flow has: a warning each; values that cannot be
+        // computed with: refused before anything is built
+        let mut warnings: Vec<String> = quantities::check(&echo_value)?
+            .into_iter()
+            .map(|w| match path {
+                Some(f) => format!("{}: {w}", f.display()),
+                None => w,
+            })
+            .collect();
         let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
         let title = file.title.clone().unwrap_or_default();
-        let mut warnings = Vec::new();
-        let mut file = file;
         let life_section = file.life.take();
         let (model, settings, tube, flow, point_abscissae) = file.build(base, &mut warnings)?;
         let life = match life_section {
@@ -187,7 +203,10 @@ fn read_case_file(text: &str) -> Result<(toml::Value, CaseFile)> {
     Ok((value, file))
 }
 
-/// A TOML error with the line and column (from 1) where it is in `text`.
+/// A TOML error with the line and column (from 1) where it is in `text`; a schema error
+/// (a value of the wrong type, an unknown or missing key) names the key as written and says
+/// what is expected in plain words (`output.every: must be a whole number ≥ 1 (a number of
+/// steps), got -1`), not in serde's.
 pub(crate) fn parse_error(text: &str, e: &toml::de::Error) -> Error {
     let (line, column) = match e.span() {
         Some(span) => {
@@ -198,10 +217,13 @@ pub(crate) fn parse_error(text: &str, e: &toml::de::Error) -> Error {
         }
         None => (0, 0),
     };
+    let raw = e.message().trim().replace('\n', " ");
+    let (key, message) = messages::schema_message(text, e.span(), &raw);
     Error::Parse {
         line,
         column,
-        message: e.message().trim().replace('\n', " "),
+        key,
+        message,
     }
 }
 

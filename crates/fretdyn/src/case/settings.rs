@@ -55,7 +55,7 @@ fn default_max_relative_error() -> f64 {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct TimeSection {
-    dt: f64,
+    pub(super) dt: f64,
     duration: f64,
 }
 
@@ -226,14 +226,17 @@ impl CaseFile {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::invalid(
                 "time.dt",
-                format!("must be a positive time step in s (got {dt})"),
+                format!("must be a positive time step in s (got {})", number(dt)),
             ));
         }
         let duration = self.time.duration;
         if !(duration.is_finite() && duration > 0.0) {
             return Err(Error::invalid(
                 "time.duration",
-                format!("must be a positive duration in s (got {duration})"),
+                format!(
+                    "must be a positive duration in s (got {})",
+                    number(duration)
+                ),
             ));
         }
         if duration < dt * (1.0 - 1e-9) {
@@ -283,7 +286,11 @@ impl CaseFile {
         if steps > 1e12 {
             return Err(Error::invalid(
                 "time.duration",
-                format!("gives {steps:e} steps of {dt} s: more than 1e12 steps"),
+                format!(
+                    "gives {} steps of {} s: more than 1e12 steps",
+                    number(steps),
+                    number(dt)
+                ),
             ));
         }
         let settings = RunSettings {
@@ -320,6 +327,9 @@ impl CaseFile {
                 ),
             ));
         }
+        // contacts and turbulence that would not fit in memory: refused with the figure
+        // before the run allocates them
+        super::memory::check(model, &settings.method)?;
         // a model without a usable stable time step (a unit slip: a mass of 1e-320 kg, a
         // radius of 1e200 m) is refused here, naming its cause; a Δt above a usable limit is
         // left to the run, which says the limit

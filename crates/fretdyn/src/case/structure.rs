@@ -203,7 +203,7 @@ impl TubeInput {
                 "structure.mesh_size",
                 format!(
                     "must be a positive element length in m (got {})",
-                    self.mesh_size
+                    number(self.mesh_size)
                 ),
             ));
         }
@@ -355,7 +355,7 @@ fn spring_restraints(k: &[f64; 6], field: &str) -> Result<[Restraint; 6]> {
     if let Some(v) = k.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
         return Err(Error::invalid(
             format!("{field}.stiffness"),
-            format!("spring stiffnesses must be ≥ 0 (got {v})"),
+            format!("spring stiffnesses must be ≥ 0 (got {})", number(*v)),
         ));
     }
     Ok(k.map(|v| {

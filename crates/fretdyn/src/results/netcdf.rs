@@ -88,15 +88,89 @@ pub(crate) fn write(
         .and_then(|()| File::open(&tmp).and_then(|f| f.sync_all()));
     if let Err(e) = written {
         let _ = std::fs::remove_file(&tmp);
-        return Err(Error::io(&path, e));
+        return Err(Error::io(&path, disk_full(e, dir)));
     }
     std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, e))?;
     Ok(path)
 }
 
-/// A netCDF error as an I/O error of the file (a full disk reaches here as an HDF5 error).
+/// A failure of the netCDF library: its message, and the error of the operating system
+/// that was pending when it failed.
+#[derive(Debug)]
+struct NetcdfFailure {
+    message: String,
+    os: std::io::Error,
+}
+
+impl std::fmt::Display for NetcdfFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for NetcdfFailure {}
+
+/// A netCDF error as an I/O error of the file. The library reports a full disk as
+/// "NetCDF: HDF error": the error number of the write that failed in it is kept (read here,
+/// at once after the failing call) for [`disk_full`] to tell.
 fn nc(e: ::netcdf::Error) -> std::io::Error {
-    std::io::Error::other(format!("netCDF: {e}"))
+    let os = std::io::Error::last_os_error();
+    std::io::Error::other(NetcdfFailure {
+        message: format!("netCDF: {e}"),
+        os,
+    })
+}
+
+/// Whether `e` says the disk (or the user's quota) is full.
+fn is_full(e: &std::io::Error) -> bool {
+    matches!(
+        e.kind(),
+        std::io::ErrorKind::StorageFull | std::io::ErrorKind::QuotaExceeded
+    )
+}
+
+/// The error to report for a failure `e` of writing `results.nc` in `dir`: a netCDF failure
+/// on a full disk becomes the system's "No space left on device (os error 28)" (like a full
+/// disk met while writing `results.npz`), with what stays written, from the error number of
+/// the write that failed or, when the library has overwritten it, from a write of one chunk
+/// ([`CHUNK_BYTES`]) of zeros in `dir` that fails the same way. Any other failure is kept
+/// as it is.
+fn disk_full(e: std::io::Error, dir: &Path) -> std::io::Error {
+    let Some(failure) = e
+        .get_ref()
+        .and_then(|inner| inner.downcast_ref::<NetcdfFailure>())
+    else {
+        return e;
+    };
+    let full = if is_full(&failure.os) {
+        match failure.os.raw_os_error() {
+            Some(code) => std::io::Error::from_raw_os_error(code),
+            None => std::io::Error::from(failure.os.kind()),
+        }
+    } else {
+        match probe_space(dir) {
+            Err(full) if is_full(&full) => full,
+            _ => return e,
+        }
+    };
+    // results.npz is packed first (crate::results::stream): it and the series stay
+    std::io::Error::new(
+        full.kind(),
+        format!("{full}: results.npz and the time histories in series/ stay written"),
+    )
+}
+
+/// Writes and removes a file of [`CHUNK_BYTES`] zeros in `dir` (synced, so that a full disk
+/// says so now).
+fn probe_space(dir: &Path) -> std::io::Result<()> {
+    use std::io::Write;
+    let path = dir.join(format!("{NETCDF_FILE}.space"));
+    let written = File::create(&path).and_then(|mut f| {
+        f.write_all(&vec![0u8; CHUNK_BYTES])?;
+        f.sync_all()
+    });
+    let _ = std::fs::remove_file(&path);
+    written
 }
 
 fn write_to(
@@ -274,6 +348,44 @@ fn strings(file: &mut ::netcdf::FileMut, d: &Variable, values: &[String]) -> std
 #[cfg(test)]
 mod tests {
     use std::ops::ControlFlow;
+
+    /// The netCDF library says "NetCDF: HDF error" for a full disk: the error number of the
+    /// write that failed says it is full (`tests/cli.rs` fills a real disk).
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_full_disk_is_said_so_with_what_stays_written() {
+        let dir = std::env::temp_dir().join(format!("fretdyn-nc-full-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let failure = |code: i32| {
+            std::io::Error::other(super::NetcdfFailure {
+                message: "netCDF: netcdf error(-101): NetCDF: HDF error".into(),
+                os: std::io::Error::from_raw_os_error(code),
+            })
+        };
+        // ENOSPC, EDQUOT
+        for (code, words) in [
+            (28, "No space left on device"),
+            (122, "Disk quota exceeded"),
+        ] {
+            let e = super::disk_full(failure(code), &dir);
+            assert!(super::is_full(&e), "{e}");
+            let text = e.to_string();
+            assert!(
+                text.starts_with(words)
+                    && text.ends_with("results.npz and the time histories in series/ stay written"),
+                "{text}"
+            );
+        }
+        // another failure (EIO) on a disk with room: the library's words
+        let e = super::disk_full(failure(5), &dir);
+        assert!(e.to_string().contains("HDF error"), "{e}");
+        // not the library's: as it is
+        let e = super::disk_full(std::io::Error::other("x"), &dir);
+        assert_eq!(e.to_string(), "x");
+        // the probe leaves nothing
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     use nalgebra::DMatrix;
 

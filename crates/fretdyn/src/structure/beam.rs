@@ -121,7 +121,7 @@ impl Tube {
             } else {
                 Err(Error::invalid(
                     format!("{field}.{name}"),
-                    format!("must be positive: {what} (got {v})"),
+                    format!("must be positive: {what} (got {})", number(v)),
                 ))
             }
         };
@@ -133,8 +133,8 @@ impl Tube {
                 format!("{field}.wall_thickness"),
                 format!(
                     "{} m is not less than the outer radius {} m: a tube's wall is thinner than its radius",
-                    s.wall_thickness,
-                    0.5 * s.outer_diameter
+                    number(s.wall_thickness),
+                    number(0.5 * s.outer_diameter)
                 ),
             ));
         }
@@ -148,7 +148,7 @@ impl Tube {
         if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
             return Err(Error::invalid(
                 format!("{field}.poisson_ratio"),
-                format!("must be in (−1, 0.5) (got {})", m.poisson_ratio),
+                format!("must be in (−1, 0.5) (got {})", number(m.poisson_ratio)),
             ));
         }
         for (v, name) in [
@@ -159,7 +159,7 @@ impl Tube {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(Error::invalid(
                     format!("{field}.{name}"),
-                    format!("must be ≥ 0 (got {v})"),
+                    format!("must be ≥ 0 (got {})", number(v)),
                 ));
             }
         }
@@ -215,7 +215,8 @@ impl Tube {
                 return Err(Error::invalid(
                     format!("{field}.{name}"),
                     format!(
-                        "gives the tube {what} of {v:e}, too extreme to compute with: check the units of {name} ({unit}) and of the other properties of the tube (outer_diameter and wall_thickness in m, density in kg/m³, young_modulus in Pa)"
+                        "gives the tube {what} of {}, too extreme to compute with: check the units of {name} ({unit}) and of the other properties of the tube (outer_diameter and wall_thickness in m, density in kg/m³, young_modulus in Pa)",
+                        number(v)
                     ),
                 ));
             }
@@ -367,7 +368,10 @@ impl Mesh {
         if !(mesh_size.is_finite() && mesh_size > 0.0) {
             return Err(Error::invalid(
                 "structure.mesh_size",
-                format!("must be a positive element length in m (got {mesh_size})"),
+                format!(
+                    "must be a positive element length in m (got {})",
+                    number(mesh_size)
+                ),
             ));
         }
         if vertices.len() < 2 || vertices.iter().any(|v| v.iter().any(|x| !x.is_finite())) {
@@ -415,7 +419,7 @@ impl Mesh {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Error::invalid(
                     format!("structure.u_bend.{name}"),
-                    format!("must be positive, in m (got {v})"),
+                    format!("must be positive, in m (got {})", number(v)),
                 ));
             }
         }
@@ -539,9 +543,12 @@ pub fn available_memory() -> f64 {
         .unwrap_or(16.0 * 1024.0 * 1024.0 * 1024.0)
 }
 
-/// `bytes` as gigabytes, for messages.
+/// `bytes` as gigabytes, for messages, to 3 significant digits as a person writes them:
+/// `12.8 GB`, `0.0512 GB`, `3.2e4 GB`.
 pub(crate) fn gigabytes(bytes: f64) -> String {
-    format!("{:.3e} GB", bytes / 1e9)
+    let gb = bytes / 1e9;
+    let rounded = format!("{gb:.2e}").parse().unwrap_or(gb);
+    format!("{} GB", crate::error::number(rounded))
 }
 
 /// How a DOF is held.

@@ -77,7 +77,8 @@ pub fn lowest_modes(
         return Err(Error::invalid(
             "structure",
             format!(
-                "a stiffness over mass ratio K_ii/M_ii is {ratio:e} (an ω² of that size): the frequencies cannot be computed; check the units of the masses and stiffnesses"
+                "a stiffness over mass ratio K_ii/M_ii is {} (an ω² of that size): the frequencies cannot be computed; check the units of the masses and stiffnesses",
+                crate::error::number(ratio)
             ),
         ));
     }

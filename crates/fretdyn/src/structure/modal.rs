@@ -9,7 +9,7 @@
 
 use nalgebra::Vector3;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, number};
 
 /// A named physical point of the structure and its mode-shape rows.
 #[derive(Debug, Clone, PartialEq)]
@@ -75,7 +75,7 @@ impl ModalBasis {
         if !(mass.is_finite() && mass > 0.0) {
             return Err(Error::invalid(
                 "structure.mass",
-                format!("must be a positive mass in kg (got {mass})"),
+                format!("must be a positive mass in kg (got {})", number(mass)),
             ));
         }
         let s = 1.0 / mass.sqrt();
@@ -109,7 +109,7 @@ impl ModalBasis {
             } else {
                 Err(Error::invalid(
                     field,
-                    format!("must be positive, in {unit} (got {v})"),
+                    format!("must be positive, in {unit} (got {})", number(v)),
                 ))
             }
         };
@@ -149,7 +149,11 @@ impl ModalBasis {
             if !(x.is_finite() && *x >= 0.0 && *x <= length) {
                 return Err(Error::invalid(
                     format!("structure.points[{j}].x"),
-                    format!("must lie on the beam, between 0 and {length} m (got {x})"),
+                    format!(
+                        "must lie on the beam, between 0 and {} m (got {})",
+                        number(length),
+                        number(*x)
+                    ),
                 ));
             }
             let mut rows = vec![0.0; 3 * p];
@@ -211,7 +215,7 @@ impl ModalBasis {
                     format!("{source}.frequencies_hz[{i}]"),
                     format!(
                         "must be a finite frequency ≥ 0 (got {}): 0 is a rigid-body mode, a negative value is not a mode",
-                        w / std::f64::consts::TAU
+                        number(w / std::f64::consts::TAU)
                     ),
                 ));
             }
@@ -295,7 +299,10 @@ pub(crate) fn check_damping_ratio(xi: f64, field: &str) -> Result<()> {
     } else {
         Err(Error::invalid(
             field,
-            format!("must be a damping ratio ≥ 0, e.g. 0.01 for 1 % (got {xi})"),
+            format!(
+                "must be a damping ratio ≥ 0, e.g. 0.01 for 1 % (got {})",
+                number(xi)
+            ),
         ))
     }
 }

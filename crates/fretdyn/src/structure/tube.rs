@@ -9,7 +9,7 @@
 
 use nalgebra::{DMatrix, Vector3};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, number};
 use crate::loads::flow::Station;
 use crate::loads::spatial_correlation::LineCell;
 use crate::model::{Model, PhysicalMatrices};
@@ -119,10 +119,12 @@ impl TubeStructure {
                     return Err(Error::invalid(
                         "structure.rayleigh",
                         format!(
-                            "α = {alpha}, β = {beta} give mode {} (ω = {:e} rad/s) the damping ratio ξ = α/(2ω) + βω/2 = {}: give α ≥ 0 in 1/s and β ≥ 0 in s that make it a finite number",
+                            "α = {}, β = {} give mode {} (ω = {} rad/s) the damping ratio ξ = α/(2ω) + βω/2 = {}: give α ≥ 0 in 1/s and β ≥ 0 in s that make it a finite number",
+                            number(*alpha),
+                            number(*beta),
                             i + 1,
-                            modes.omega[i],
-                            ratios[i]
+                            number(modes.omega[i]),
+                            number(ratios[i])
                         ),
                     ));
                 }
@@ -441,8 +443,14 @@ pub fn node_at(mesh: &Mesh, at: &Vector3<f64>, tolerance: f64, field: &str) -> R
         Err(Error::invalid(
             field,
             format!(
-                "no node at [{}, {}, {}]: the nearest is {distance:.3e} m away, at [{:.6}, {:.6}, {:.6}]; put the point on a node (a path vertex, or a multiple of the mesh size along a segment)",
-                at.x, at.y, at.z, x.x, x.y, x.z
+                "no node at [{}, {}, {}]: the nearest is {} m away, at [{}, {}, {}]; put the point on a node (a path vertex, or a multiple of the mesh size along a segment)",
+                number(at.x),
+                number(at.y),
+                number(at.z),
+                number(distance),
+                number(x.x),
+                number(x.y),
+                number(x.z)
             ),
         ))
     }
