@@ -78,6 +78,12 @@ fn load(path: &Path) -> Result<Case, Failure> {
     for w in &case.warnings {
         errln!("warning: {w}");
     }
+    // impacts resolved by too few steps (THEORY §2)
+    for w in
+        fretdyn::integrator::stability::impact_resolution_warnings(&case.model, case.settings.dt)
+    {
+        errln!("warning: {}: {w}", path.display());
+    }
     if let Some(report) = case.stability() {
         for m in report.unstable() {
             errln!(
@@ -436,7 +442,8 @@ pub fn run_and_write(
     }
 }
 
-/// Warnings on the standard errors of a run (THEORY §5): once if the batches are correlated
+/// Warnings on a run: its energy balance's error above 1 % (THEORY §5, with the time step
+/// that would fix it), and on its standard errors (THEORY §5): once if the batches are correlated
 /// (too short against the correlation time), one line per contact whose relative standard
 /// errors exceed `[statistics] max_relative_error`, naming the statistics, and a target
 /// relative error that was not met. Only contacts with at least one impact per batch on
@@ -445,7 +452,8 @@ pub fn run_and_write(
 /// `summary.json`, say nothing worth a warning.
 pub fn error_warnings(case: &Case, r: &RunResults) -> Vec<String> {
     let st = &case.settings.statistics;
-    let mut out = Vec::new();
+    // the energy balance's error (THEORY §5): a time step too coarse
+    let mut out = fretdyn::results::energy::energy_warnings(&r.energy, r.dt);
     let stationary =
         |c: &&fretdyn::results::statistics::ContactStatistics| c.impacts >= c.errors.batches.max(2);
     let correlated: Vec<String> = r

@@ -181,7 +181,7 @@ fn v1a_impact_on_the_first_step_has_its_row_duration_and_peak() {
 /// motion before the contact is exact: it reaches the plane exactly at `t_0 = 1024 Δt`, and
 /// the statistics window starts exactly there. The impact starts at `t_0` (its first closed
 /// step is the window's first) and is counted, tabled and measured once; with the window
-/// starting in the middle of the impact, it is neither counted nor tabled.
+/// starting in the middle of the impact, it starts with the window (THEORY §11).
 #[test]
 fn impact_starting_exactly_at_the_window_start_is_counted_once_with_its_row() {
     let (kn, v) = (1e6f64, 1.0f64);
@@ -232,15 +232,34 @@ fn impact_starting_exactly_at_the_window_start_is_counted_once_with_its_row() {
         let counted: u64 = c.peak_force_histogram.iter().map(|b| b.count).sum();
         assert_eq!(counted, 1, "{label}");
 
-        // a window that starts during the impact: not counted, no row
+        // a window that starts during the impact: the impact starts with the window (issue
+        // 3.1, THEORY §11), at the start of its first step (within Δt/2 of t_start), lasts to
+        // the opening at t0 + π/ω, and its impact speed is the approach speed there,
+        // v cos(ω (t − t0)) = 0 at the deepest point (to ω v Δt/2)
+        let t_start = t0 + 0.5 * duration;
         let stats = StatisticsSettings {
-            t_start: t0 + 0.5 * duration,
+            t_start,
             ..Default::default()
         };
         let r = simulate(&model, &settings(method, dt, steps, stats)).unwrap();
-        assert_eq!(r.contacts[0].impacts, 0, "{label}");
-        assert!(r.impacts.is_empty(), "{label}: {:?}", r.impacts);
-        assert!(r.contacts[0].peak_force_histogram.is_empty(), "{label}");
+        assert_eq!(r.contacts[0].impacts, 1, "{label}");
+        assert_eq!(r.impacts.len(), 1, "{label}: {:?}", r.impacts);
+        let imp = &r.impacts[0];
+        assert!((imp.start - t_start).abs() <= 0.5 * dt, "{label}: {imp:?}");
+        assert!(
+            (imp.start + imp.duration - (t0 + duration)).abs() <= wdt2 * duration,
+            "{label}: {imp:?}"
+        );
+        assert!(imp.impact_speed.abs() <= omega * v * dt, "{label}: {imp:?}");
+        assert_eq!(
+            r.contacts[0]
+                .peak_force_histogram
+                .iter()
+                .map(|b| b.count)
+                .sum::<u64>(),
+            1,
+            "{label}"
+        );
     }
 }
 

@@ -72,6 +72,12 @@ pub struct TangentialProblem {
     h_for: Vec<usize>,
     /// Whether every slot's rows are fixed (kept by [`Self::clear`] and [`Self::push_with`]).
     all_fixed: bool,
+    /// Whether a contact with fixed rows has a singular block ([`DiagonalBlock::is_singular`];
+    /// set by [`Self::fix_rows`]).
+    fixed_singular: bool,
+    /// Whether a slot whose rows are not fixed has a singular block this step (set by
+    /// [`Self::assemble`], reset by [`Self::clear`]).
+    moving_singular: bool,
 }
 
 impl TangentialProblem {
@@ -97,6 +103,8 @@ impl TangentialProblem {
             singular: None,
             h_for: Vec::with_capacity(contacts),
             all_fixed: true,
+            fixed_singular: false,
+            moving_singular: false,
         }
     }
 
@@ -141,6 +149,19 @@ impl TangentialProblem {
             self.h_fixed[(r + 1) * st + r + 1],
         );
         self.blocks[contact] = DiagonalBlock::new(h);
+        self.fixed_singular =
+            (0..self.fixed.len()).any(|c| self.fixed[c] && self.blocks[c].is_singular());
+    }
+
+    /// Whether a closed contact's diagonal block may be singular this step
+    /// ([`DiagonalBlock::is_singular`]: no mode moves its point along a tangent direction):
+    /// always when a contact with fixed rows has a singular block, else when a closed one
+    /// without fixed rows has. The solvers then take the local solves and residuals that
+    /// handle it (THEORY §4.4); otherwise, the common case, the same code without their
+    /// tests.
+    #[inline(always)]
+    pub fn may_be_singular(&self) -> bool {
+        self.fixed_singular | self.moving_singular
     }
 
     #[inline(always)]
@@ -167,6 +188,7 @@ impl TangentialProblem {
         self.slots.clear();
         self.block_of.clear();
         self.all_fixed = true;
+        self.moving_singular = false;
     }
 
     /// Number of closed contacts `m` (the problem has `2m` unknowns).
@@ -303,7 +325,9 @@ impl TangentialProblem {
             self.newton[k].set(f64::NAN);
             if !fixed_k {
                 // a fixed contact's block was prepared once ([`Self::diagonal_block`])
-                self.blocks[self.block_of[k]] = DiagonalBlock::new(self.block(k, k));
+                let block = DiagonalBlock::new(self.block(k, k));
+                self.moving_singular |= block.is_singular();
+                self.blocks[self.block_of[k]] = block;
             }
         }
     }
@@ -385,22 +409,29 @@ impl TangentialProblem {
     }
 
     /// [`Self::natural_map_residual`] of a single contact whose local right-hand side
-    /// (`b`, or the one its last sweep recorded) is `c`.
+    /// (`b`, or the one its last sweep recorded) is `c` (`SINGULAR`: [`slot_residual`]).
     #[inline(always)]
-    fn single_residual(&self, lambda: Vector2<f64>, c: Vector2<f64>, slide: Slide) -> f64 {
+    fn single_residual<const SINGULAR: bool>(
+        &self,
+        lambda: Vector2<f64>,
+        c: Vector2<f64>,
+        slide: Slide,
+    ) -> f64 {
         let block = self.diagonal_block(0);
         let slot = &self.slots[0];
-        let (r2, l2) = slot_residual(lambda, c - block.h * lambda, block.rho(), slot, slide);
+        let (r2, l2) =
+            slot_residual::<SINGULAR>(lambda, c - block.h * lambda, block.rho(), slot, slide);
         relative_residual(0.0 + r2, 0.0 + l2, 0.0f64.max(slot.s_static))
     }
 
     /// [`Self::natural_map_residual_after_sweep`] of a single closed contact whose sweep
-    /// found `lambda` with status `slide`: the same operations, inlined into the caller (the
-    /// common case of a rattling structure, at every step with a closed contact).
+    /// found `lambda` with status `slide`, its block regular ([`Self::may_be_singular`]
+    /// false): the same operations, inlined into the caller (the common case of a rattling
+    /// structure, at every step with a closed contact).
     #[inline(always)]
     pub fn single_residual_after_sweep(&self, lambda: Vector2<f64>, slide: Slide) -> f64 {
         let [c, _] = self.sweep[0].get();
-        self.single_residual(lambda, c, slide)
+        self.single_residual::<false>(lambda, c, slide)
     }
 
     /// Records slot `k`'s local solve in a Gauss–Seidel sweep: its right-hand side `c_k`
@@ -421,13 +452,24 @@ impl TangentialProblem {
         lambda: &[Vector2<f64>],
         slide: &[Slide],
     ) -> f64 {
+        self.natural_map_residual_after_sweep_with::<true>(lambda, slide)
+    }
+
+    /// [`Self::natural_map_residual_after_sweep`]; `!SINGULAR` when no block is singular
+    /// ([`Self::may_be_singular`], [`slot_residual`]).
+    #[inline(always)]
+    pub(crate) fn natural_map_residual_after_sweep_with<const SINGULAR: bool>(
+        &self,
+        lambda: &[Vector2<f64>],
+        slide: &[Slide],
+    ) -> f64 {
         let m = self.slots.len().min(lambda.len());
         if m == 1 {
             // a single contact (the common case), without the loops: the same operations
             let [c, _] = self.sweep[0].get();
-            return self.single_residual(lambda[0], c, slide[0]);
+            return self.single_residual::<SINGULAR>(lambda[0], c, slide[0]);
         }
-        self.natural_map(lambda, slide, |k| {
+        self.natural_map::<SINGULAR>(lambda, slide, |k| {
             let [c, _] = self.sweep[k].get();
             let mut w = c - self.diagonal_block(k).h * lambda[k];
             for j in k + 1..m {
@@ -447,11 +489,23 @@ impl TangentialProblem {
         slide: &[Slide],
         rhs: impl Fn(usize) -> Option<Vector2<f64>>,
     ) -> f64 {
+        self.natural_map_residual_given_with::<true>(lambda, slide, rhs)
+    }
+
+    /// [`Self::natural_map_residual_given`]; `!SINGULAR` when no block is singular
+    /// ([`Self::may_be_singular`], [`slot_residual`]).
+    #[inline(always)]
+    pub(crate) fn natural_map_residual_given_with<const SINGULAR: bool>(
+        &self,
+        lambda: &[Vector2<f64>],
+        slide: &[Slide],
+        rhs: impl Fn(usize) -> Option<Vector2<f64>>,
+    ) -> f64 {
         if self.slots.len() == 1 && !lambda.is_empty() {
             // a single contact (the common case), without the loops: the same operations
-            return self.single_residual(lambda[0], self.rhs(0), slide[0]);
+            return self.single_residual::<SINGULAR>(lambda[0], self.rhs(0), slide[0]);
         }
-        self.natural_map(lambda, slide, |k| match rhs(k) {
+        self.natural_map::<SINGULAR>(lambda, slide, |k| match rhs(k) {
             Some(c) => c - self.diagonal_block(k).h * lambda[k],
             None => self.residual_velocity(k, lambda),
         })
@@ -459,7 +513,7 @@ impl TangentialProblem {
 
     /// The natural-map residual with the residual velocities `w(k) = (b − Hλ)_k`.
     #[inline]
-    fn natural_map(
+    fn natural_map<const SINGULAR: bool>(
         &self,
         lambda: &[Vector2<f64>],
         slide: &[Slide],
@@ -469,7 +523,7 @@ impl TangentialProblem {
         let mut l2 = 0.0;
         let mut s_max = 0.0f64;
         for (k, slot) in self.slots.iter().enumerate() {
-            let (r, l) = slot_residual(
+            let (r, l) = slot_residual::<SINGULAR>(
                 lambda[k],
                 w(k),
                 self.diagonal_block(k).rho(),
@@ -561,8 +615,13 @@ impl TangentialProblem {
     /// the others' λ fixed, by Cholesky on the `2|S|` unknowns. `work` must hold
     /// `(2m)² + 4m` values and `index` 2m. Returns true when `H_SS` was singular (a pivot below `1e-12`
     /// of the largest diagonal term), in which case a Tikhonov term of that size regularises
-    /// it (THEORY §4.6). A single stick slot is solved by its block's inverse
-    /// (THEORY §4.3).
+    /// it (THEORY §4.6): when `b_S − H_SF λ_F` has a component `x_d` along a null direction
+    /// of `H_SS` (no λ makes those contacts stick), the regularised `λ_S` has one of
+    /// `x_d/(10^k τ)` along it, beyond the static disks unless `|x_d|` is of the order of
+    /// `τ s`, and the Active Set's stick test refuses it. A single stick slot is solved by
+    /// its block's inverse, regularised as in the local solves ([`DiagonalBlock`],
+    /// THEORY §4.3, §4.4); a slot whose block is zero is coupled with no other and is solved
+    /// alone ([`DiagonalBlock::stick_force`]).
     pub fn solve_stick(
         &self,
         stick: &[bool],
@@ -585,9 +644,23 @@ impl TangentialProblem {
         if n == 2 {
             // one stick contact (a structure that sticks, mostly): its unknowns are its
             // local problem's free solution `H_kk⁻¹ c_k`, the inverse formed once per step
-            if let Some(x) = self.single_stick(index[0] / 2, lambda) {
-                lambda[index[0] / 2] = x;
-                return false;
+            // (regularised when singular, as in the local solves: THEORY §4.4)
+            let k = index[0] / 2;
+            let block = self.diagonal_block(k);
+            if block.is_singular() {
+                return self.single_singular_stick(k, lambda);
+            }
+            lambda[k] = block.inverse() * self.local_rhs(k, lambda);
+            return false;
+        }
+        let mut singular = false;
+        if self.may_be_singular() && self.blocks_zero(stick) {
+            // a zero block's λ is its own (no mode moves its point: it is coupled with no
+            // other contact), and its H_kk = 0 would leave the factorisation no scale
+            n = self.drop_zero_blocks(stick, lambda, index);
+            singular = true;
+            if n == 0 {
+                return true;
             }
         }
         let (a, rest) = work.split_at_mut(n * n);
@@ -610,31 +683,61 @@ impl TangentialProblem {
             }
             x[i] = v;
         }
-        let singular = cholesky_solve(a, diag, x, n, 1e-12 * dmax.max(f64::MIN_POSITIVE));
+        singular |= cholesky_solve(a, diag, x, n, 1e-12 * dmax.max(f64::MIN_POSITIVE));
         for i in (0..n).step_by(2) {
             lambda[index[i] / 2] = Vector2::new(x[i], x[i + 1]);
         }
         singular
     }
 
-    /// [`Self::solve_stick`] of the single stick slot `k`: `λ_k = H_kk⁻¹ c_k`, with
-    /// `c_k = b_k − Σ_{l≠k} H_kl λ_l`, by the block's inverse ([`DiagonalBlock`], formed
-    /// once per step) instead of a factorisation on the dependent chain of every status
-    /// iteration. `None` when `H_kk` is singular by either test, the Cholesky's (a pivot
-    /// `h₀₀` or `h₁₁ − h₀₁²/h₀₀` below `1e-12 max|h_ii|`, then regularised by the general
-    /// path) or [`inverse2`]'s (`det < 1e-13 max|h_ii|²`, whose pseudo-inverse is not the
-    /// regularised solution): the two then solve the same regular system, up to round-off.
+    /// [`Self::solve_stick`] of the single stick slot `k` whose block is singular: its
+    /// block's stick force ([`DiagonalBlock::stick_force`], as in its local solves). Returns
+    /// true (singular).
+    #[cold]
+    #[inline(never)]
+    fn single_singular_stick(&self, k: usize, lambda: &mut [Vector2<f64>]) -> bool {
+        let c = self.local_rhs(k, lambda);
+        lambda[k] = self
+            .diagonal_block(k)
+            .stick_force(&c, self.slots[k].s_static);
+        true
+    }
+
+    /// Whether a stick slot's diagonal block is zero ([`DiagonalBlock::is_zero`]).
     #[inline]
-    fn single_stick(&self, k: usize, lambda: &[Vector2<f64>]) -> Option<Vector2<f64>> {
-        let block = self.diagonal_block(k);
-        let h = &block.h;
-        let (a, b, d) = (h[(0, 0)], h[(0, 1)], h[(1, 1)]);
-        let dmax = a.abs().max(d.abs());
-        let tiny = 1e-12 * dmax.max(f64::MIN_POSITIVE);
-        let det = a * d - b * h[(1, 0)];
-        // a > tiny and d − b²/a > tiny (times a > 0), and inverse2's regular branch
-        let regular = a > tiny && det > a * tiny && det > 1e-13 * dmax * dmax;
-        regular.then(|| block.inverse() * self.local_rhs(k, lambda))
+    fn blocks_zero(&self, stick: &[bool]) -> bool {
+        (0..self.slots.len()).any(|k| stick[k] && self.diagonal_block(k).is_zero())
+    }
+
+    /// [`Self::solve_stick`] when a stick slot's block is zero: such a slot's `L_k` rows are
+    /// zero (`H_kk = L_k A⁻¹ L_kᵀ`, `A⁻¹` positive), so it is coupled with no other slot and
+    /// its `λ_k` is its block's stick force ([`DiagonalBlock::stick_force`]: 0 when its
+    /// right-hand side is, else one the stick test refuses). Writes those, and the unknowns
+    /// of the other stick slots into `index`; returns their number.
+    #[cold]
+    #[inline(never)]
+    fn drop_zero_blocks(
+        &self,
+        stick: &[bool],
+        lambda: &mut [Vector2<f64>],
+        index: &mut [usize],
+    ) -> usize {
+        let mut n = 0;
+        for k in 0..self.slots.len() {
+            if !stick[k] {
+                continue;
+            }
+            let block = self.diagonal_block(k);
+            if block.is_zero() {
+                let c = self.local_rhs(k, lambda);
+                lambda[k] = block.stick_force(&c, self.slots[k].s_static);
+            } else {
+                index[n] = 2 * k;
+                index[n + 1] = 2 * k + 1;
+                n += 2;
+            }
+        }
+        n
     }
 }
 
@@ -746,8 +849,10 @@ fn same_contacts(contacts: &[usize], slots: &[Slot]) -> bool {
 
 /// One slot's terms of the natural-map residual ([`TangentialProblem::natural_map_residual`]):
 /// `(|λ − proj_{disk(s)}(λ + ρ w)|², |λ|²)` for its `λ`, residual velocity `w`, `ρ` and status.
+/// `SINGULAR`: a zero block's `ρ = ∞` is taken as its limit ([`zero_block_residual`]);
+/// without it (no block singular, [`TangentialProblem::may_be_singular`]) `ρ` is finite.
 #[inline(always)]
-fn slot_residual(
+fn slot_residual<const SINGULAR: bool>(
     lambda: Vector2<f64>,
     w: Vector2<f64>,
     rho: f64,
@@ -758,9 +863,28 @@ fn slot_residual(
         Slide::Stick => slot.s_static,
         Slide::Slip => slot.s_dynamic,
     };
+    if SINGULAR && !(rho < f64::INFINITY) {
+        return zero_block_residual(lambda, w, s);
+    }
     let z = lambda + w * rho;
     let n2 = z.norm_squared();
     let projected = if n2 > s * s { z * (s / n2.sqrt()) } else { z };
+    ((lambda - projected).norm_squared(), lambda.norm_squared())
+}
+
+/// [`slot_residual`] of a zero block (`ρ = ∞`, [`DiagonalBlock::rho`]): the natural map's
+/// limit `proj_{disk(s)}(λ + ρ w) → s w/|w|` when `w ≠ 0`, `proj(λ)` when `w = 0` — the
+/// residual is 0 exactly for Coulomb's solutions, `λ = s w/|w|` or `w = 0`, `|λ| ≤ s`.
+#[cold]
+#[inline(never)]
+fn zero_block_residual(lambda: Vector2<f64>, w: Vector2<f64>, s: f64) -> (f64, f64) {
+    let nw = w.norm();
+    let projected = if nw > 0.0 {
+        w * (s / nw)
+    } else {
+        let nl = lambda.norm();
+        if nl > s { lambda * (s / nl) } else { lambda }
+    };
     ((lambda - projected).norm_squared(), lambda.norm_squared())
 }
 
@@ -909,21 +1033,54 @@ mod tests {
         }
     }
 
-    /// A stick contact whose block is singular (its two tangent rows equal) is not solved by
-    /// the inverse: the general path regularises it and says so.
+    /// A stick contact whose block is singular (its two tangent rows equal): its stick force
+    /// is the local solve's — the minimum-norm one when its right-hand side has no component
+    /// along the null direction `d = (1, −1)/√2`, where it sticks exactly — and the solve says
+    /// that the block was singular. With a component along `d` (the tangents' obstacle
+    /// velocities differ: no λ makes it stick), the force is beyond the static disk, and the
+    /// Active Set's stick test refuses it.
     #[test]
-    fn a_singular_single_stick_block_goes_to_the_regularised_path() {
+    fn a_singular_single_stick_block_is_solved_as_the_local_problem() {
         let (p, contacts) = (4, 1);
         let mut problem = TangentialProblem::new(p, contacts);
         let t = Vector3::new(0.0, 0.6, 0.8);
         let rows: Vec<f64> = (0..3 * p).map(|i| ((i * 5) % 7) as f64 - 2.5).collect();
         problem.fix_rows(0, &[t, t], &rows, |l, out| out.copy_from_slice(l));
-        closed(&mut problem, &[0]);
-        assert!(problem.single_stick(0, &[Vector2::zeros()]).is_none());
         let (mut work, mut index) = (vec![0.0; 8], vec![0; 2]);
-        let mut lambda = [Vector2::zeros()];
-        assert!(problem.solve_stick(&[true], &mut lambda, &mut work, &mut index));
-        assert!(lambda[0].x.is_finite() && lambda[0].y.is_finite());
+        for (vimp, sticks) in [(Vector2::zeros(), true), (Vector2::new(1e-3, 0.0), false)] {
+            problem.clear();
+            let slot = Slot {
+                contact: 0,
+                s_static: 1e3,
+                s_dynamic: 0.8e3,
+            };
+            problem.push(slot, &[Vector3::zeros(); 2], &[], &[]);
+            problem.assemble(&[0.1, -0.2, 0.3, 0.4], &[1.0, 2.0, -1.0, 0.5], 1e-3, |_| {
+                vimp
+            });
+            assert!(problem.diagonal_block(0).is_singular());
+            let mut lambda = [Vector2::zeros()];
+            assert!(problem.solve_stick(&[true], &mut lambda, &mut work, &mut index));
+            let l = lambda[0];
+            let (local, slide) = crate::contact::friction::local_solve(
+                &problem.block(0, 0),
+                &problem.rhs(0),
+                1e3,
+                0.8e3,
+                crate::contact::friction::LocalSolve::Exact,
+            );
+            if sticks {
+                assert_eq!(slide, Slide::Stick);
+                assert_eq!(l, local);
+                // the minimum norm: nothing along d, and no slip velocity
+                assert!((l.x - l.y).abs() <= 1e-12 * l.norm(), "{l}");
+                let w = problem.residual_velocity(0, &lambda);
+                assert!(w.norm() <= 1e-12 * problem.rhs(0).norm(), "w = {w}");
+            } else {
+                assert_eq!(slide, Slide::Slip);
+                assert!(l.norm() > 1e3, "λ = {l} would pass the stick test");
+            }
+        }
     }
 
     /// The square-root-free pivot test gives the Cholesky's answer: regular for SPD matrices

@@ -72,11 +72,26 @@ impl LocalSolve {
     }
 }
 
+/// Relative threshold below which an eigenvalue of a contact's block `H_ii` counts as zero:
+/// `τ = SINGULAR_RATIO · max(h₁₁, h₂₂)`, the threshold of the singularity test of `H` and of
+/// the Active Set's Cholesky (THEORY §4.4, §4.6).
+pub const SINGULAR_RATIO: f64 = 1e-12;
+
 /// A contact's 2 × 2 diagonal block `H_ii` of the Delassus operator with what its local solve
 /// needs of it: its inverse ([`inverse2`]) and its eigen-decomposition, formed once per step
 /// rather than at every sweep — the eigen-decomposition (two square roots, two divisions)
 /// only when an exact slip solve first asks for it, so that a sticking contact, or the
 /// radial projection, never pays for it.
+///
+/// A block with an eigenvalue at most `τ = 1e-12 max(h₁₁, h₂₂)` ([`SINGULAR_RATIO`]) is
+/// **singular**: along its eigenvector `d` no mode moves the contact point, and the slip
+/// velocity's component `c·d` does not depend on `λ`. Its free solution is that of the block
+/// with that eigenvalue raised to `τ`, `H_τ⁻¹c = Σ_k q_k (q_k·c)/max(h_k, τ)`
+/// ([`Self::stick_force`]), so that the stick test `|H_τ⁻¹c| ≤ s` fails when `|c·d| > τ s`
+/// (no `λ` can stop the slip along `d`: the contact slides), passes with the minimum-norm
+/// `λ` when `c·d = 0`, and is continuous with that of a block whose eigenvalue is just above
+/// `τ` (THEORY §4.4). It is formed in the eigenbasis, term by term: as a matrix, `1/τ` would
+/// swamp the other eigenvalue's term.
 #[derive(Debug, Clone)]
 pub struct DiagonalBlock {
     /// `H_ii`.
@@ -85,6 +100,8 @@ pub struct DiagonalBlock {
     /// The eigen-decomposition `H = Q diag(h) Qᵀ` for the exact slip solution, once formed.
     eigen: Cell<Option<(Matrix2<f64>, [f64; 2])>>,
     isotropic: bool,
+    /// An eigenvalue at most `τ` ([`Self::is_singular`]).
+    singular: bool,
     /// `2/tr(H_ii)` ([`Self::rho`]).
     rho: f64,
 }
@@ -94,14 +111,24 @@ impl DiagonalBlock {
     /// its first exact slip solve and kept (for the run, for a fixed plane's block).
     #[inline]
     pub fn new(h: Matrix2<f64>) -> Self {
+        let (inverse, singular) = regularised_inverse(&h);
         Self {
             h,
-            inverse: inverse2(&h),
+            inverse,
             eigen: Cell::new(None),
             isotropic: is_isotropic(&h),
+            singular,
             rho: {
                 let trace = h[(0, 0)] + h[(1, 1)];
-                if trace > 0.0 { 2.0 / trace } else { 0.0 }
+                // a zero block (nothing moves the point in the tangent plane): ρ = ∞, the
+                // natural map's limit, whose residual is 0 only for λ = s w/|w| (w ≠ 0)
+                if trace > 0.0 {
+                    2.0 / trace
+                } else if trace == 0.0 {
+                    f64::INFINITY
+                } else {
+                    0.0
+                }
             },
         }
     }
@@ -120,17 +147,89 @@ impl DiagonalBlock {
         }
     }
 
-    /// `H_ii⁻¹` ([`inverse2`]: the pseudo-inverse when `H_ii` is singular).
+    /// `H_ii⁻¹` of a regular block; not a number for a singular one, whose free solution is
+    /// [`Self::stick_force`]'s (so that a free solution formed with it fails every stick test
+    /// and goes to [`singular_solve`]).
     #[inline]
     pub fn inverse(&self) -> &Matrix2<f64> {
         &self.inverse
     }
 
-    /// The step `ρ = 2/tr(H_ii)` of the natural map (THEORY §4.2), 0 for a zero block.
+    /// Whether `H_ii` has an eigenvalue at most `τ = 1e-12 max(h₁₁, h₂₂)`: a direction in the
+    /// tangent plane along which no mode moves the contact point (THEORY §4.4).
+    #[inline]
+    pub fn is_singular(&self) -> bool {
+        self.singular
+    }
+
+    /// Whether `H_ii = 0`: no mode moves the contact point in its tangent plane.
+    #[inline]
+    pub fn is_zero(&self) -> bool {
+        self.h[(0, 0)] == 0.0 && self.h[(1, 1)] == 0.0
+    }
+
+    /// The stick force `H_ii⁻¹ c` of the local problem with the right-hand side `c`; for a
+    /// singular block `H_τ⁻¹c` (the minimum-norm one when `c` has no component along the
+    /// null direction). A zero block has none unless `c = 0`: for `c ≠ 0` the force returned,
+    /// along `c`, is twice `s_static` (at least `1.5e-154`), so that a stick test
+    /// `|λ| ≤ s_static` fails, and finite (THEORY §4.3).
+    #[inline]
+    pub fn stick_force(&self, c: &Vector2<f64>, s_static: f64) -> Vector2<f64> {
+        if self.singular {
+            singular_stick_force(self, c, s_static)
+        } else {
+            self.inverse * c
+        }
+    }
+
+    /// `τ = 1e-12 max(h₁₁, h₂₂)`.
+    #[inline]
+    fn tau(&self) -> f64 {
+        SINGULAR_RATIO * self.h[(0, 0)].abs().max(self.h[(1, 1)].abs())
+    }
+
+    /// `H_τ⁻¹c = Σ_k q_k (q_k·c)/max(h_k, τ)` in the eigenbasis (a singular, nonzero block).
+    fn raised_free(&self, c: &Vector2<f64>) -> Vector2<f64> {
+        let (q, e) = self.eigen();
+        let tau = self.tau();
+        let cp = q.transpose() * c;
+        // a NaN eigenvalue (a diverging run) stays NaN
+        let raised = |k: usize| if e[k] < tau { tau } else { e[k] };
+        q * Vector2::new(cp[0] / raised(0), cp[1] / raised(1))
+    }
+
+    /// The step `ρ = 2/tr(H_ii)` of the natural map (THEORY §4.2), `∞` for a zero block.
     #[inline]
     pub fn rho(&self) -> f64 {
         self.rho
     }
+}
+
+/// [`DiagonalBlock::stick_force`] of a singular block.
+#[cold]
+#[inline(never)]
+fn singular_stick_force(block: &DiagonalBlock, c: &Vector2<f64>, s_static: f64) -> Vector2<f64> {
+    if !block.is_zero() {
+        return block.raised_free(c);
+    }
+    match unit(c) {
+        Some(u) => u * (2.0 * s_static).max(f64::MIN_POSITIVE.sqrt()),
+        None if c.x == 0.0 && c.y == 0.0 => Vector2::zeros(),
+        // not a number: the step diverges
+        None => c * f64::NAN,
+    }
+}
+
+/// `c/|c|`, its norm formed scaled (no overflow or underflow); `None` for `c = 0` or a `c`
+/// that is not finite.
+#[inline]
+fn unit(c: &Vector2<f64>) -> Option<Vector2<f64>> {
+    let m = c.amax();
+    if !(m > 0.0 && m.is_finite()) {
+        return None;
+    }
+    let scaled = c / m;
+    Some(scaled / scaled.norm())
 }
 
 impl Default for DiagonalBlock {
@@ -143,8 +242,11 @@ impl Default for DiagonalBlock {
 /// find `λ` such that, with `w = c − H λ` (the slip velocity up to the factor θΔt),
 /// either `w = 0` and `|λ| ≤ s_static` (stick), or `λ = s_dynamic w/|w|` (slip).
 ///
-/// `h` is the contact's 2 × 2 diagonal block of the Delassus operator (SPD), `c` the right-hand
-/// side with the other contacts' multipliers subtracted.
+/// `h` is the contact's 2 × 2 diagonal block of the Delassus operator (symmetric positive
+/// semi-definite), `c` the right-hand side with the other contacts' multipliers subtracted.
+/// A singular `h` (THEORY §4.4): the contact slides when `c` has a component along the
+/// null direction (above `τ s_static`, [`DiagonalBlock`]), sticks with the minimum-norm
+/// `λ` otherwise when that is inside the static disk.
 #[inline]
 pub fn local_solve(
     h: &Matrix2<f64>,
@@ -161,8 +263,32 @@ pub fn local_solve(
 /// exact slip solution's Newton start: the root of the contact's last exact slip solve of
 /// this step (NaN: none), where the next one starts — the sweeps and the status iterations
 /// of a step solve the same contact with nearly the same right-hand side.
+///
+/// A singular block ([`DiagonalBlock`]: an eigenvalue at most `τ`) has an inverse that is not
+/// a number: its free solution fails the stick test, and [`singular_solve`] decides — stick
+/// when `|H_τ⁻¹ c| ≤ s_static` (a component of `c` along the null direction `d` above
+/// `τ s_static` fails it), else the slip solution, which satisfies `λ ∥ w` with
+/// `w·d = c·d ≠ 0`. The one test this costs, on the slip path, also catches a free solution
+/// whose square overflows. The solvers run the same code without it on a step whose blocks are
+/// all regular ([`local_solve_with`], THEORY §4.4).
 #[inline(always)]
 pub fn local_solve_block(
+    block: &DiagonalBlock,
+    c: &Vector2<f64>,
+    s_static: f64,
+    s_dynamic: f64,
+    mode: LocalSolve,
+    newton: &Cell<f64>,
+) -> (Vector2<f64>, Slide) {
+    local_solve_with::<true>(block, c, s_static, s_dynamic, mode, newton)
+}
+
+/// [`local_solve_block`] (`SINGULAR`), or without its test for a singular block
+/// (`!SINGULAR`: the code of a step whose closed contacts' blocks are all regular,
+/// [`crate::contact::delassus::TangentialProblem::may_be_singular`]; on a singular block its
+/// answer is then not a number).
+#[inline(always)]
+pub(crate) fn local_solve_with<const SINGULAR: bool>(
     block: &DiagonalBlock,
     c: &Vector2<f64>,
     s_static: f64,
@@ -176,6 +302,11 @@ pub fn local_solve_block(
     if norm2 <= s_static * s_static {
         return (free, Slide::Stick);
     }
+    if SINGULAR && !(norm2 < f64::INFINITY) {
+        // a singular block (its inverse is not a number), or |H⁻¹c|² beyond the largest
+        // number
+        return singular_solve(block, c, s_static, s_dynamic, mode, newton);
+    }
     if s_dynamic <= 0.0 {
         return (Vector2::zeros(), Slide::Slip);
     }
@@ -188,6 +319,57 @@ pub fn local_solve_block(
     (lambda, Slide::Slip)
 }
 
+/// [`local_solve_block`] when the free solution `H_ii⁻¹c` is not a finite vector (THEORY
+/// §4.4):
+/// - a zero block `H_ii = 0`: the slip velocity is `c` whatever `λ` — stick with `λ = 0`
+///   when `c = 0`, else slip with `λ = s_dynamic c/|c|`, the exact and the radial solutions
+///   alike;
+/// - a singular block: stick with `λ = H_τ⁻¹c` ([`DiagonalBlock::stick_force`]) when that is
+///   in the static disk; else slip, the exact solution from the block's own eigenvalues
+///   ([`disk_boundary_solve`]: its secular equation has a root `t > 0`), the radial one the
+///   projection of `H_τ⁻¹c` on the dynamic circle;
+/// - a regular block whose free solution's square overflows: its slip solution, the radial
+///   projection's norm formed scaled.
+#[cold]
+#[inline(never)]
+fn singular_solve(
+    block: &DiagonalBlock,
+    c: &Vector2<f64>,
+    s_static: f64,
+    s_dynamic: f64,
+    mode: LocalSolve,
+    newton: &Cell<f64>,
+) -> (Vector2<f64>, Slide) {
+    let free = if block.singular {
+        if block.is_zero() {
+            return match unit(c) {
+                Some(u) if s_dynamic > 0.0 => (u * s_dynamic, Slide::Slip),
+                _ if c.x == 0.0 && c.y == 0.0 => (Vector2::zeros(), Slide::Stick),
+                Some(_) => (Vector2::zeros(), Slide::Slip),
+                None => (c * f64::NAN, Slide::Slip),
+            };
+        }
+        let free = block.raised_free(c);
+        if free.norm_squared() <= s_static * s_static {
+            return (free, Slide::Stick);
+        }
+        free
+    } else {
+        block.inverse * c
+    };
+    if s_dynamic <= 0.0 {
+        return (Vector2::zeros(), Slide::Slip);
+    }
+    let lambda = match mode {
+        LocalSolve::Exact if !block.isotropic => disk_boundary_solve(block, c, s_dynamic, newton),
+        _ => match unit(&free) {
+            Some(u) => u * s_dynamic,
+            None => free * f64::NAN,
+        },
+    };
+    (lambda, Slide::Slip)
+}
+
 /// `H = h I`: then `(sH + tI)u = c` makes `u` parallel to `c`, hence to `H⁻¹c`, and the exact
 /// slip solution is the radial projection of the free one, in closed form.
 #[inline]
@@ -195,47 +377,40 @@ fn is_isotropic(h: &Matrix2<f64>) -> bool {
     h[(0, 1)] == 0.0 && h[(1, 0)] == 0.0 && h[(0, 0)] == h[(1, 1)]
 }
 
-/// `H⁻¹` for a 2 × 2 matrix, or its pseudo-inverse when `H` is singular (a pivot below
-/// `1e-13` of the largest diagonal term: the least-squares solution along the dominant
-/// eigenvector).
+/// `H⁻¹` for a symmetric positive semi-definite 2 × 2 matrix whose eigenvalues are above
+/// `τ = 1e-12 max(h₁₁, h₂₂)` ([`SINGULAR_RATIO`]); not a number for a singular one (an
+/// eigenvalue at most `τ`: [`DiagonalBlock`] solves with it, THEORY §4.4).
 #[inline]
 pub fn inverse2(h: &Matrix2<f64>) -> Matrix2<f64> {
+    regularised_inverse(h).0
+}
+
+/// [`inverse2`] and whether `h` is singular. `h_min ≤ τ` is tested without the
+/// eigenvalues: with `τ ≤ h_max` (a diagonal term is at most `h_max`), `(τ − h_min)(τ − h_max)
+/// = τ² − τ tr H + det H ≤ 0` exactly when `h_min ≤ τ`; a regular `h` takes the closed-form
+/// inverse.
+#[inline(always)]
+fn regularised_inverse(h: &Matrix2<f64>) -> (Matrix2<f64>, bool) {
     let det = h[(0, 0)] * h[(1, 1)] - h[(0, 1)] * h[(1, 0)];
     let scale = h[(0, 0)].abs().max(h[(1, 1)].abs());
-    if det.abs() > 1e-13 * scale * scale {
+    let tau = SINGULAR_RATIO * scale;
+    if det > tau * (h[(0, 0)] + h[(1, 1)] - tau) {
         let id = 1.0 / det;
-        Matrix2::new(
-            h[(1, 1)] * id,
-            -h[(0, 1)] * id,
-            -h[(1, 0)] * id,
-            h[(0, 0)] * id,
+        (
+            Matrix2::new(
+                h[(1, 1)] * id,
+                -h[(0, 1)] * id,
+                -h[(1, 0)] * id,
+                h[(0, 0)] * id,
+            ),
+            false,
         )
     } else {
-        pseudo_inverse2(h, scale)
+        (Matrix2::repeat(f64::NAN), true)
     }
 }
 
-/// The pseudo-inverse of a singular symmetric 2 × 2 matrix whose largest diagonal term is
-/// `scale` (zero for a zero matrix).
-#[cold]
-#[inline(never)]
-fn pseudo_inverse2(h: &Matrix2<f64>, scale: f64) -> Matrix2<f64> {
-    let mut out = Matrix2::zeros();
-    if scale > 0.0 {
-        let eig = h.symmetric_eigen();
-        for k in 0..2 {
-            let e = eig.eigenvalues[k];
-            if e.abs() > 1e-13 * scale {
-                let v = eig.eigenvectors.column(k);
-                out += v * v.transpose() / e;
-            }
-        }
-    }
-    out
-}
-
-/// `H⁻¹ c` for a 2 × 2 matrix, with a pseudo-inverse fallback when `H` is singular
-/// ([`inverse2`]).
+/// `H⁻¹ c` for a regular 2 × 2 matrix ([`inverse2`]; not a number when `H` is singular).
 #[inline]
 pub fn solve2(h: &Matrix2<f64>, c: &Vector2<f64>) -> Vector2<f64> {
     inverse2(h) * c
@@ -262,7 +437,6 @@ fn disk_boundary_solve(
     s: f64,
     newton: &Cell<f64>,
 ) -> Vector2<f64> {
-    let h = &block.h;
     let (q, eigenvalues) = block.eigen();
     let hs = [s * eigenvalues[0], s * eigenvalues[1]];
     let cp = q.transpose() * c;
@@ -403,7 +577,11 @@ fn disk_boundary_solve(
             u * (s / n)
         } else {
             // Degenerate input (c = 0 cannot slide): project the free solution radially.
-            let free = solve2(h, c);
+            let free = if block.singular {
+                block.raised_free(c)
+            } else {
+                block.inverse * c
+            };
             let nf = free.norm();
             if nf > 0.0 { free * (s / nf) } else { free }
         }
@@ -733,6 +911,198 @@ mod tests {
                 (lam - reference).norm() <= 1e-9 * s,
                 "H = {h}, c = {c}, s = {s}: {lam} vs {reference}"
             );
+        }
+    }
+
+    /// `λ` on the circle of radius `s` along `w = c − Hλ`: Coulomb's slip condition.
+    fn assert_slides(h: &Matrix2<f64>, c: &Vector2<f64>, lam: &Vector2<f64>, s: f64, what: &str) {
+        let w = c - h * lam;
+        assert!(
+            (lam.norm() - s).abs() <= 1e-14 * s,
+            "{what}: |λ| = {}",
+            lam.norm()
+        );
+        let sine = (lam.x * w.y - lam.y * w.x) / (lam.norm() * w.norm());
+        assert!(sine.abs() <= 1e-12, "{what}: λ = {lam} not along w = {w}");
+        assert!(lam.dot(&w) > 0.0, "{what}: λ = {lam} against w = {w}");
+    }
+
+    /// A rank-one block `H = h v vᵀ` (no mode moves the point along `d = v⊥`): a right-hand
+    /// side with a component `β` along `d` cannot be met by any λ (the slip velocity along
+    /// `d` is `β` whatever λ), so the contact slides on the dynamic circle even when the
+    /// regular part `α/h` is well inside the static disk (it stuck before: the pseudo-inverse
+    /// dropped `β`). The exact solution is that of the secular equation
+    /// `α²/(sh + t)² + β²/t² = 1`, `λ = s (α/(sh + t), β/t)` in the basis `(v, d)`, found here by
+    /// bisection; the radial one is the projection of the block's regularised free solution,
+    /// `(α/h) v + (β/τ) d`, nearly `s sign(β) d`.
+    #[test]
+    fn a_singular_block_slides_when_c_has_a_component_along_its_null_direction() {
+        let (h, s) = (3.0, 0.5);
+        for angle in [0.0, 0.3, std::f64::consts::FRAC_PI_2, 2.0] {
+            let v = Vector2::new(f64::cos(angle), f64::sin(angle));
+            let d = Vector2::new(-v.y, v.x);
+            let hm = v * v.transpose() * h;
+            for (alpha, beta) in [
+                (0.3, 1e-3),
+                (0.3, -2.0),
+                (-1.0, 0.05),
+                (0.0, 1.0),
+                (5.0, 1.0),
+            ] {
+                let c = v * alpha + d * beta;
+                let what = format!("θ = {angle}, α = {alpha}, β = {beta}");
+                let block = DiagonalBlock::new(hm);
+                assert!(block.is_singular(), "{what}");
+                let (lam, st) = local_solve(&hm, &c, 2.0 * s, s, LocalSolve::Exact);
+                assert_eq!(st, Slide::Slip, "{what}");
+                assert_slides(&hm, &c, &lam, s, &what);
+                // the secular equation by bisection: |u(t)| decreases from ∞ at t = 0
+                let size = |t: f64| ((alpha / (s * h + t)).powi(2) + (beta / t).powi(2)).sqrt();
+                let (mut lo, mut hi) = (0.0, c.norm());
+                for _ in 0..300 {
+                    let mid = 0.5 * (lo + hi);
+                    if size(mid) > 1.0 { lo = mid } else { hi = mid }
+                }
+                let reference = (v * (alpha / (s * h + hi)) + d * (beta / hi)) * s;
+                assert!(
+                    (lam - reference).norm() <= 1e-12 * s,
+                    "{what}: {lam} vs {reference}"
+                );
+
+                let (rad, st) = local_solve(&hm, &c, 2.0 * s, s, LocalSolve::Radial);
+                assert_eq!(st, Slide::Slip, "{what}: radial");
+                let tau = SINGULAR_RATIO * hm[(0, 0)].max(hm[(1, 1)]);
+                let free = v * (alpha / h) + d * (beta / tau);
+                let expected = free * (s / free.norm());
+                assert!(
+                    (rad - expected).norm() <= 1e-12 * s,
+                    "{what}: {rad} vs {expected}"
+                );
+                assert!(
+                    rad.dot(&d) * beta.signum() >= s * (1.0 - 1e-9),
+                    "{what}: {rad}"
+                );
+            }
+        }
+    }
+
+    /// A rank-one block with a right-hand side along the range of `H` only (`c·d = 0`,
+    /// exactly: `d` a coordinate axis) inside the static disk sticks, with the minimum-norm
+    /// force `(α/h) v` — nothing along `d` — and no slip velocity; outside the disk it slides
+    /// along `v` (`λ = s sign(α) v`). Rotated (`d` not an axis, so that `c·d` is round-off),
+    /// the force along `d` is `c·d/τ`: a few `ε|c|/τ` (a few 1e-4 of `|c|/h`).
+    #[test]
+    fn a_singular_block_sticks_with_the_minimum_norm_force_when_c_is_in_its_range() {
+        let (h, s) = (3.0, 0.5);
+        for (hm, c, v) in [
+            (
+                Matrix2::new(h, 0.0, 0.0, 0.0),
+                Vector2::new(0.9, 0.0),
+                Vector2::x(),
+            ),
+            (
+                Matrix2::new(0.0, 0.0, 0.0, h),
+                Vector2::new(0.0, -1.2),
+                Vector2::y(),
+            ),
+        ] {
+            for mode in [LocalSolve::Exact, LocalSolve::Radial] {
+                let (lam, st) = local_solve(&hm, &c, s, 0.8 * s, mode);
+                assert_eq!(st, Slide::Stick, "{hm} {c}");
+                assert_eq!(lam, c / h, "{hm} {c}: the minimum-norm force");
+                assert!((c - hm * lam).norm() <= f64::EPSILON * c.norm(), "no slip");
+                // outside the static disk: slides along v
+                let (lam, st) = local_solve(&hm, &(c * 10.0), s, 0.8 * s, mode);
+                assert_eq!(st, Slide::Slip);
+                let expected = v * (0.8 * s * c.dot(&v).signum());
+                assert!((lam - expected).norm() <= 1e-15 * s, "{lam} vs {expected}");
+            }
+        }
+        for angle in [0.3, 1.0, 2.5] {
+            let v = Vector2::new(f64::cos(angle), f64::sin(angle));
+            let hm = v * v.transpose() * h;
+            let c = v * 0.9;
+            let (lam, st) = local_solve(&hm, &c, s, 0.8 * s, LocalSolve::Exact);
+            assert_eq!(st, Slide::Stick, "θ = {angle}");
+            let d = Vector2::new(-v.y, v.x);
+            assert!((lam.dot(&v) - 0.3).abs() <= 1e-15, "θ = {angle}: {lam}");
+            // c·d is round-off, a few ε|c|, and the force along d that over τ
+            let tau = SINGULAR_RATIO * hm[(0, 0)].max(hm[(1, 1)]);
+            let bound = 4.0 * f64::EPSILON * c.norm() / tau;
+            assert!(lam.dot(&d).abs() <= bound, "θ = {angle}: {lam}");
+        }
+    }
+
+    /// A zero block (no mode moves the point in its tangent plane): the slip velocity is `c`
+    /// whatever λ — it sticks with `λ = 0` when `c = 0`, and otherwise slides with
+    /// `λ = s c/|c|`, whatever the static disk (it stuck before, with `λ = 0`).
+    #[test]
+    fn a_zero_block_slides_along_c_unless_c_is_zero() {
+        let h = Matrix2::zeros();
+        for mode in [LocalSolve::Exact, LocalSolve::Radial] {
+            let (lam, st) = local_solve(&h, &Vector2::zeros(), 1.0, 0.5, mode);
+            assert_eq!((lam, st), (Vector2::zeros(), Slide::Stick));
+            for (c, unit) in [
+                (Vector2::new(1e-300, 0.0), Vector2::x()),
+                (Vector2::new(-3.0, 4.0), Vector2::new(-0.6, 0.8)),
+                (Vector2::new(0.0, 1e300), Vector2::y()),
+            ] {
+                let (lam, st) = local_solve(&h, &c, 1e6, 0.5, mode);
+                assert_eq!(st, Slide::Slip, "{c}");
+                let expected = unit * 0.5;
+                assert!((lam - expected).norm() <= 1e-16, "{c}: {lam}");
+            }
+            let (lam, st) = local_solve(&h, &Vector2::new(1.0, 1.0), 1.0, 0.0, mode);
+            assert_eq!((lam, st), (Vector2::zeros(), Slide::Slip));
+        }
+        let block = DiagonalBlock::new(h);
+        assert!(block.is_singular() && block.is_zero());
+        assert_eq!(block.stick_force(&Vector2::zeros(), 1.0), Vector2::zeros());
+        assert!(block.stick_force(&Vector2::new(0.0, 1e-9), 1.0).norm() > 1.0);
+        assert!(
+            block
+                .stick_force(&Vector2::new(0.0, 1e-9), 0.0)
+                .norm_squared()
+                > 0.0
+        );
+    }
+
+    /// Continuity across the threshold `τ`: a block `h v vᵀ + ε d dᵀ` whose small eigenvalue
+    /// `ε` crosses `τ` (regular above, singular below) gives the same stick/slip answer and the
+    /// same λ on both sides, to the relative size `δ` of the step in `ε`, both for a
+    /// right-hand side whose null component sticks (`|c·d| = τ s/2`) and for one that slides
+    /// (`2τ s`); below `τ` the answer no longer depends on `ε`. For a rotated block (`d` not
+    /// an axis) the determinant `h ε` is formed from products of size `h²`: it, the singularity
+    /// test and the regular inverse along `d` are then known to `ε_mach h/ε ≈ 1e-4` only, and
+    /// the step and the tolerance are `1e-3`.
+    #[test]
+    fn a_block_crossing_the_singularity_threshold_is_solved_continuously() {
+        let (h, s) = (3.0, 0.5);
+        for (angle, delta, tolerance) in [(0.0, 1e-7, 1e-6), (0.7, 1e-3, 3e-3)] {
+            let v = Vector2::new(f64::cos(angle), f64::sin(angle));
+            let d = Vector2::new(-v.y, v.x);
+            let block = |eps: f64| v * v.transpose() * h + d * d.transpose() * eps;
+            let t0 = SINGULAR_RATIO * block(0.0)[(0, 0)].max(block(0.0)[(1, 1)]);
+            for (null, slide) in [(0.5 * t0 * s, Slide::Stick), (2.0 * t0 * s, Slide::Slip)] {
+                let c = v * 0.6 + d * null;
+                let mut answers = Vec::new();
+                for ratio in [1.0 + delta, 1.0 - delta, 0.5, 0.0] {
+                    let b = block(ratio * t0);
+                    assert_eq!(DiagonalBlock::new(b).is_singular(), ratio < 1.0, "{ratio}");
+                    for mode in [LocalSolve::Exact, LocalSolve::Radial] {
+                        let (lam, st) = local_solve(&b, &c, s, s, mode);
+                        assert_eq!(st, slide, "θ = {angle}, ε = {ratio} τ, {mode:?}");
+                        answers.push((ratio, mode, lam));
+                    }
+                }
+                for (ratio, mode, lam) in &answers[2..] {
+                    let (_, _, above) = answers[if *mode == LocalSolve::Exact { 0 } else { 1 }];
+                    assert!(
+                        (lam - above).norm() <= tolerance * s,
+                        "θ = {angle}, {slide:?}, {mode:?}: ε = {ratio} τ gives {lam}, above τ {above}"
+                    );
+                }
+            }
         }
     }
 }

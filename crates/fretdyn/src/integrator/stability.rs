@@ -6,6 +6,10 @@
 //! i.e. explicitly; their largest rate `c_max` (same construction) lowers the limit to
 //! `(2/ω_max)(√(1+ζ²) − ζ)`, `ζ = c_max/(2 ω_max)`, the limit of an explicitly damped oscillator.
 //!
+//! The stability limit says nothing about accuracy: a contact whose impacts last only a few
+//! steps is stable but coarse. [`impact_resolution`] gives each contact's impact duration in
+//! steps, and [`impact_resolution_warnings`] the warning before a run (THEORY §2).
+//!
 //! A model whose terms are not finite numbers (a mass of 1e-320 kg, a radius of 1e200 m: a
 //! unit slip) has no stable time step: [`checked_stable_time_step`] refuses it naming the
 //! culprit, before the eigen solver (which would not terminate on such a matrix) runs.
@@ -237,4 +241,142 @@ fn largest_eigenvalue(m: DMatrix<f64>) -> Option<f64> {
         return None;
     }
     Some(m.symmetric_eigenvalues().max())
+}
+
+/// Fewest time steps an impact should last: at 15 steps per impact the energy balance of an
+/// elastic impact errs by about 0.9 % (case V1a; 0.6 % on an oscillator bouncing on a stop),
+/// and the error falls as `Δt²` (THEORY §2, VERIFICATION.md "Steps per impact").
+pub const MIN_STEPS_PER_IMPACT: f64 = 15.0;
+
+/// How finely the impacts of one contact are resolved in time by a time step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImpactResolution {
+    /// Index of the contact.
+    pub contact: usize,
+    /// Effective mass at the contact point along its normal, `1/(nᵀ Φ_c M⁻¹ Φ_cᵀ n)`, kg
+    /// (for a hole or a polygon, the most mobile normal of its plane).
+    pub effective_mass: f64,
+    /// Duration of an elastic impact on the normal spring, `π √(m_eff/K_N)`, s.
+    pub duration: f64,
+    /// That duration in time steps.
+    pub steps: f64,
+}
+
+/// The impacts' resolution of every contact that a mode can move along its normal
+/// ([`ImpactResolution`]), with the time step `dt`.
+///
+/// The mobility of the contact point is `G = Φ_c M⁻¹ Φ_cᵀ` (`Φ_c Φ_cᵀ` on a mass-normalised
+/// modal basis, where `M = I`); along a normal `n`, `nᵀ G n = 1/m_eff`. On the tube's surface
+/// the normal row is the axis point's (`n·(R n × Θ) = 0`, THEORY §3), so the point's rows
+/// serve. An impact on the penalty spring `K_N` lasts about half a period of `m_eff` on it,
+/// `π √(m_eff/K_N)` (exactly so for a point mass; the structure's own stiffness shortens it).
+pub fn impact_resolution(model: &Model, dt: f64) -> Vec<ImpactResolution> {
+    let mass_factor = match &model.coordinates {
+        Coordinates::Modal => None,
+        Coordinates::Physical(m) => m.mass.clone().cholesky(),
+    };
+    let mut out = Vec::new();
+    for (index, contact) in model.contacts.iter().enumerate() {
+        let rows = &model.basis.points[contact.point].rows;
+        let p = rows.len() / 3;
+        if p == 0 || !(contact.normal.stiffness > 0.0) {
+            continue;
+        }
+        // the three rows, and M⁻¹ applied to them (physical coordinates)
+        let r = DMatrix::from_row_slice(3, p, rows);
+        let g = match (&model.coordinates, &mass_factor) {
+            (Coordinates::Physical(_), Some(chol)) => &r * chol.solve(&r.transpose()),
+            (Coordinates::Physical(_), None) => continue,
+            (Coordinates::Modal, _) => &r * r.transpose(),
+        };
+        let quadratic = |a: &Vector3<f64>, b: &Vector3<f64>| {
+            let mut s = 0.0;
+            for i in 0..3 {
+                for j in 0..3 {
+                    s += a[i] * g[(i, j)] * b[j];
+                }
+            }
+            s
+        };
+        let (normals, _) = contact.obstacle.penalty_directions();
+        let mobility = match normals.as_slice() {
+            [n] => quadratic(n, n),
+            [a, b] => {
+                // the largest eigenvalue of G restricted to the plane of the normals
+                let (aa, ab, bb) = (quadratic(a, a), quadratic(a, b), quadratic(b, b));
+                0.5 * (aa + bb) + (0.25 * (aa - bb).powi(2) + ab * ab).sqrt()
+            }
+            _ => continue,
+        };
+        if !(mobility > 0.0 && mobility.is_finite()) {
+            continue;
+        }
+        let effective_mass = 1.0 / mobility;
+        let duration = std::f64::consts::PI / (contact.normal.stiffness * mobility).sqrt();
+        out.push(ImpactResolution {
+            contact: index,
+            effective_mass,
+            duration,
+            steps: duration / dt,
+        });
+    }
+    out
+}
+
+/// The largest time step, rounded down to two digits, that resolves the impacts of every
+/// contact of `model` with at least [`MIN_STEPS_PER_IMPACT`] steps ([`impact_resolution`]);
+/// `None` when no mode moves a contact point along its normal.
+pub fn impact_time_step(model: &Model) -> Option<f64> {
+    let shortest = impact_resolution(model, 1.0)
+        .iter()
+        .map(|r| r.duration)
+        .reduce(f64::min)?;
+    Some(crate::results::energy::round_down(
+        shortest / MIN_STEPS_PER_IMPACT,
+        |dt| shortest / dt >= MIN_STEPS_PER_IMPACT,
+    ))
+}
+
+/// A warning when `dt` resolves some contact's impacts with fewer than
+/// [`MIN_STEPS_PER_IMPACT`] steps ([`impact_resolution`]): one line naming the contacts, the
+/// steps per impact, and the `time.dt` that would resolve every impact with that many
+/// ([`impact_time_step`]).
+pub fn impact_resolution_warnings(model: &Model, dt: f64) -> Vec<String> {
+    let coarse: Vec<ImpactResolution> = impact_resolution(model, dt)
+        .into_iter()
+        .filter(|r| r.steps < MIN_STEPS_PER_IMPACT)
+        .collect();
+    let Some(suggested) = impact_time_step(model).filter(|_| !coarse.is_empty()) else {
+        return Vec::new();
+    };
+    const NAMED: usize = 4;
+    let mut names: Vec<String> = coarse
+        .iter()
+        .take(NAMED)
+        .map(|r| {
+            format!(
+                "'{}' ({:.1} steps: π √(m_eff/K_N) = {} s, m_eff = {} kg)",
+                model.contacts[r.contact].name,
+                r.steps,
+                three_digits(r.duration),
+                three_digits(r.effective_mass)
+            )
+        })
+        .collect();
+    if coarse.len() > NAMED {
+        names.push(format!("{} more", coarse.len() - NAMED));
+    }
+    vec![format!(
+        "time.dt = {} s resolves the impacts of contact{} {} with fewer than {} steps each: the energy balance then errs by about 1 % or more and impact forces and durations are coarse (THEORY §2); set time.dt to at most {} s",
+        number(dt),
+        if coarse.len() > 1 { "s" } else { "" },
+        names.join(", "),
+        MIN_STEPS_PER_IMPACT,
+        number(suggested)
+    )]
+}
+
+/// `x` to three significant digits, as [`number`] writes it.
+fn three_digits(x: f64) -> String {
+    number(format!("{x:.2e}").parse().unwrap_or(x))
 }

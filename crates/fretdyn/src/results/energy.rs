@@ -3,7 +3,43 @@
 
 use serde::Serialize;
 
+use crate::error::number;
 use crate::kernels::running_max;
+
+/// Relative error of the energy balance ([`EnergyBalance::relative_error`]) above which a run
+/// is worth a warning: 1 %, about what 15 steps per impact give (VERIFICATION.md "Steps per
+/// impact"), and a bias of that size on the energy the contacts exchange, hence on their
+/// impact forces and wear.
+pub const MAX_RELATIVE_ERROR: f64 = 0.01;
+
+/// The time step that should bring the relative error of the energy balance `energy`
+/// (settled, [`EnergyBalance::settle`]) of a run of time step `dt` to half
+/// [`MAX_RELATIVE_ERROR`], when its error exceeds that: central differences are of order 2,
+/// and so is the balance's error on impacts (measured, VERIFICATION.md "Steps per impact"),
+/// so that `Δt √(0.5 %/error)` does (rounded down to two digits). `None` when the error is
+/// at most [`MAX_RELATIVE_ERROR`].
+pub fn energy_time_step(energy: &EnergyBalance, dt: f64) -> Option<f64> {
+    let error = energy.relative_error;
+    (error > MAX_RELATIVE_ERROR)
+        .then(|| round_down(dt * (0.5 * MAX_RELATIVE_ERROR / error).sqrt(), |_| true))
+}
+
+/// The warning on a run's energy balance `energy` (settled) when its relative error exceeds
+/// [`MAX_RELATIVE_ERROR`], with the time step of [`energy_time_step`]; `dt` is the run's time
+/// step. One line, or none.
+pub fn energy_warnings(energy: &EnergyBalance, dt: f64) -> Vec<String> {
+    let Some(suggested) = energy_time_step(energy, dt) else {
+        return Vec::new();
+    };
+    vec![format!(
+        "the energy balance errs by {:.2} % of the largest energy (energy_balance.relative_error in summary.json, above {} %): time.dt = {} s is too coarse for the motion, its impacts most likely; the error falls as Δt², and time.dt = {} s should bring it to about {} % (THEORY §5)",
+        100.0 * energy.relative_error,
+        number(100.0 * MAX_RELATIVE_ERROR),
+        number(dt),
+        number(suggested),
+        number(50.0 * MAX_RELATIVE_ERROR)
+    )]
+}
 
 /// Discrete energy balance: `E(t) − E(0) − W_ext − W_fe + D`, with `E` kinetic + strain +
 /// normal penalty potential, `W_ext` the work of external loads, `W_fe` the work of the
@@ -129,5 +165,37 @@ impl EnergyBalance {
             + self.modal_damping
             + self.contact_damping
             + self.tangential
+    }
+}
+
+/// `x` rounded down to two significant digits, lowered by a unit of the second digit until
+/// `fits` holds (so that a round-off of the division cannot make it fail); `x` itself when
+/// it is not a positive finite number.
+pub(crate) fn round_down(x: f64, fits: impl Fn(f64) -> bool) -> f64 {
+    if !(x > 0.0 && x.is_finite()) {
+        return x;
+    }
+    // x = k / scale with 10 ≤ k < 100: the division by a power of ten gives the double
+    // nearest to the decimal number
+    let exponent = 1 - x.log10().floor() as i32;
+    let scale = 10f64.powi(exponent);
+    let mut k = (x * scale).floor();
+    while k > 1.0 && !(k / scale <= x && fits(k / scale)) {
+        k -= 1.0;
+    }
+    k / scale
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_down_keeps_two_digits_and_the_condition() {
+        assert_eq!(round_down(1.4567e-5, |_| true), 1.4e-5);
+        assert_eq!(round_down(9.99, |_| true), 9.9);
+        assert_eq!(round_down(0.3, |_| true), 0.3);
+        assert_eq!(round_down(1.4e-5, |dt| dt < 1.4e-5), 1.3e-5);
+        assert!(round_down(f64::NAN, |_| true).is_nan());
     }
 }

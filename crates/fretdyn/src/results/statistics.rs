@@ -11,7 +11,10 @@
 //! the step in which it starts does (the same midpoint rule, not the interpolated start time:
 //! an impact that starts on the window's first step, e.g. a contact closed from `t_start`
 //! exactly, is counted once and has its row, its duration and its peak in the histogram like
-//! any other). An impact still going on when the run ends is ended there.
+//! any other). An impact under way when the window opens — a contact closed at the start of
+//! the window's first step, a preload at t = 0 or the middle of an impact — starts there
+//! ([`ContactStatisticsState::open_window`]). An impact still going on when the run ends is
+//! ended there.
 //!
 //! One concept, kept whole: the window, the blocks, the impacts and the peak histogram are
 //! accumulated from the same step values by one midpoint rule, in one state per contact (the
@@ -255,7 +258,10 @@ pub struct Impact {
     pub impulse: f64,
     /// Normal approach speed at the first closing, m/s: `(δ_{n+1} − δ_n)/Δt` over the step
     /// where it closes, the central-difference velocity `q̇_{n+½}`, on which no contact force
-    /// has acted yet.
+    /// has acted yet. For an impact under way when the statistics window opens (it starts
+    /// there, [`ContactStatisticsState::open_window`]): the normal approach speed `δ̇` at the
+    /// window's start, from the full-step velocity `q̇` there (at t = 0 the initial velocity;
+    /// negative when the contact is opening).
     pub impact_speed: f64,
     /// Normal separation speed at the last opening, m/s: `(δ_n − δ_{n+1})/Δt` over the step
     /// where it opens.
@@ -1092,21 +1098,29 @@ pub fn name_blocks(blocks: &mut [BlockStatistics], names: &[String]) {
 const BLOCK_ROOM: u64 = 4096;
 
 impl StatisticsSettings {
-    /// Steps of a run of `steps` steps of `dt` that count in the window (midpoint rule).
-    pub fn window_steps(&self, steps: u64, dt: f64) -> u64 {
-        // first and last step in the window, found near their estimates by the rule itself
+    /// The first step (numbered from 1, the step ending at `n Δt`) of a run of `steps` steps
+    /// of `dt` that counts in the window (midpoint rule); `None` when none does.
+    pub fn first_window_step(&self, steps: u64, dt: f64) -> Option<u64> {
+        // found near its estimate by the rule itself
         let inside = |n: u64| n >= 1 && n <= steps && self.step_in_window(n as f64 * dt, dt);
-        let estimate = |t: f64| ((t / dt + 0.5).floor().max(0.0) as u64).min(steps);
-        let mut first = estimate(self.t_start);
+        let mut first = ((self.t_start / dt + 0.5).floor().max(0.0) as u64).min(steps);
         while first > 1 && inside(first - 1) {
             first -= 1;
         }
         while first <= steps && !inside(first) {
             first += 1;
         }
-        if first > steps {
+        (first <= steps).then_some(first)
+    }
+
+    /// Steps of a run of `steps` steps of `dt` that count in the window (midpoint rule).
+    pub fn window_steps(&self, steps: u64, dt: f64) -> u64 {
+        // first and last step in the window, found near their estimates by the rule itself
+        let inside = |n: u64| n >= 1 && n <= steps && self.step_in_window(n as f64 * dt, dt);
+        let estimate = |t: f64| ((t / dt + 0.5).floor().max(0.0) as u64).min(steps);
+        let Some(first) = self.first_window_step(steps, dt) else {
             return 0;
-        }
+        };
         let mut last = estimate(self.t_end.min(steps as f64 * dt)).max(first);
         while last < steps && inside(last + 1) {
             last += 1;
@@ -1199,6 +1213,51 @@ impl ContactStatisticsState {
             tr.previous_t = 0.0;
             // a contact closed at t = 0 is in an impact that started before the run
             tr.active = closed;
+        }
+    }
+
+    /// Opens the window at `t`, the end of the last step before it (the start of its first
+    /// step: `t_start` to within `Δt/2`, exactly when `t_start` is a multiple of `Δt`).
+    /// An impact under way there — its contact closed at `t`, from an impact that started
+    /// before the window, or closed at t = 0 — **starts at `t`** (THEORY §11): it is counted
+    /// in the window, and its row has its start `t`, its duration, contact time, impulse,
+    /// peak and rebounds from `t` on, and as impact speed `speeds[k]`, the contact's normal
+    /// approach speed at `t`. One in a rebound opening at `t` ends there, out of the window:
+    /// its closing within the rest duration, if any, starts an impact in the window.
+    /// Called once, at `t` (by the time loop; at t = 0 after [`Self::start`]).
+    pub fn open_window(&mut self, t: f64, speeds: impl Iterator<Item = f64>) {
+        for (k, ((tracker, block), speed)) in self
+            .trackers
+            .iter_mut()
+            .zip(&mut self.block)
+            .zip(speeds)
+            .enumerate()
+        {
+            if !tracker.active {
+                continue;
+            }
+            if tracker.open {
+                tracker.active = false;
+                tracker.open = false;
+                tracker.current = None;
+                continue;
+            }
+            tracker.current = Some(Impact {
+                contact: k,
+                start: t,
+                duration: 0.0,
+                contact_time: 0.0,
+                peak_time: t,
+                peak_force: 0.0,
+                impulse: 0.0,
+                impact_speed: speed,
+                rebound_speed: 0.0,
+                rebounds: 0,
+                angle_deg: 0.0,
+            });
+            tracker.peak_direction = [1.0, 0.0];
+            tracker.in_window = true;
+            block.impacts += 1;
         }
     }
 

@@ -26,7 +26,7 @@ use nalgebra::Vector2;
 
 use super::{ActiveSetSettings, SolverStatistics, gauss_seidel};
 use crate::contact::delassus::TangentialProblem;
-use crate::contact::friction::{LocalSolve, Slide, local_solve_block};
+use crate::contact::friction::{LocalSolve, Slide, local_solve_with};
 
 /// Memory of a contact between steps: its last status and slip direction.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -89,8 +89,41 @@ impl ActiveSet {
     }
 
     /// Solves the problem; `history[contact]` gives each closed contact's previous status.
-    /// Writes λ and the statuses of the slots, and counts into `stats`.
+    /// Writes λ and the statuses of the slots, and counts into `stats`. A step where a
+    /// contact's block may be singular ([`TangentialProblem::may_be_singular`]) runs the local
+    /// solves that handle it (THEORY §4.4); the others the same code without their test.
     pub fn solve(
+        &mut self,
+        problem: &TangentialProblem,
+        history: &[History],
+        lambda: &mut [Vector2<f64>],
+        slide: &mut [Slide],
+        stats: &mut SolverStatistics,
+    ) -> Outcome {
+        if problem.may_be_singular() {
+            return self.solve_singular(problem, history, lambda, slide, stats);
+        }
+        self.solve_with::<false>(problem, history, lambda, slide, stats)
+    }
+
+    /// [`Self::solve`] of a step where a block may be singular, apart from the common step's
+    /// code.
+    #[cold]
+    #[inline(never)]
+    fn solve_singular(
+        &mut self,
+        problem: &TangentialProblem,
+        history: &[History],
+        lambda: &mut [Vector2<f64>],
+        slide: &mut [Slide],
+        stats: &mut SolverStatistics,
+    ) -> Outcome {
+        self.solve_with::<true>(problem, history, lambda, slide, stats)
+    }
+
+    /// [`Self::solve`], its local solves for singular blocks when `SINGULAR`.
+    #[inline(always)]
+    fn solve_with<const SINGULAR: bool>(
         &mut self,
         problem: &TangentialProblem,
         history: &[History],
@@ -141,7 +174,8 @@ impl ActiveSet {
                     let bound = slot.s_static * (1.0 + 1e-12);
                     if lambda[k].norm_squared() > bound * bound {
                         self.stick[k] = false;
-                        let (local, _) = local_exact(problem, k, problem.local_rhs(k, lambda));
+                        let (local, _) =
+                            local_exact::<SINGULAR>(problem, k, problem.local_rhs(k, lambda));
                         let n = local.norm();
                         self.direction[k] = if n > 0.0 {
                             local / n
@@ -153,7 +187,7 @@ impl ActiveSet {
                 } else {
                     let c = problem.local_rhs(k, lambda);
                     self.rhs[k] = c;
-                    let (local, local_slide) = local_exact(problem, k, c);
+                    let (local, local_slide) = local_exact::<SINGULAR>(problem, k, c);
                     if local_slide == Slide::Stick {
                         self.stick[k] = true;
                         status_changed = true;
@@ -242,8 +276,24 @@ impl ActiveSet {
         lambda: &[Vector2<f64>],
         slide: &[Slide],
     ) -> f64 {
-        problem
-            .natural_map_residual_given(lambda, slide, |k| (!self.stick[k]).then_some(self.rhs[k]))
+        if problem.may_be_singular() {
+            return self.residual_singular(problem, lambda, slide);
+        }
+        let rhs = |k: usize| (!self.stick[k]).then_some(self.rhs[k]);
+        problem.natural_map_residual_given_with::<false>(lambda, slide, rhs)
+    }
+
+    /// [`Self::residual`] of a step where a block may be singular.
+    #[cold]
+    #[inline(never)]
+    fn residual_singular(
+        &self,
+        problem: &TangentialProblem,
+        lambda: &[Vector2<f64>],
+        slide: &[Slide],
+    ) -> f64 {
+        let rhs = |k: usize| (!self.stick[k]).then_some(self.rhs[k]);
+        problem.natural_map_residual_given_with::<true>(lambda, slide, rhs)
     }
 }
 
@@ -251,9 +301,13 @@ impl ActiveSet {
 /// [`TangentialProblem::local_rhs`]; THEORY §4.4); in line (it runs for every contact at every
 /// status iteration).
 #[inline(always)]
-fn local_exact(problem: &TangentialProblem, k: usize, c: Vector2<f64>) -> (Vector2<f64>, Slide) {
+fn local_exact<const SINGULAR: bool>(
+    problem: &TangentialProblem,
+    k: usize,
+    c: Vector2<f64>,
+) -> (Vector2<f64>, Slide) {
     let slot = &problem.slots()[k];
-    local_solve_block(
+    local_solve_with::<SINGULAR>(
         problem.diagonal_block(k),
         &c,
         slot.s_static,

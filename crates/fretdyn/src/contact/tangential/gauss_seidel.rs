@@ -12,7 +12,7 @@ use nalgebra::Vector2;
 
 use super::GaussSeidelSettings;
 use crate::contact::delassus::TangentialProblem;
-use crate::contact::friction::{LocalSolve, Slide, local_solve_block};
+use crate::contact::friction::{LocalSolve, Slide, local_solve_with};
 
 /// Result of one solve.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,6 +29,9 @@ pub struct Sweeps {
 ///
 /// A single closed contact, the common case of a rattling structure, is solved in line
 /// (`solve_single_radial`, `solve_single_exact`); several by the sweeps (`solve_by_sweeps`).
+/// A step where a contact's block may be singular ([`TangentialProblem::may_be_singular`])
+/// is solved by the sweeps whose local solves and residual handle it (THEORY §4.4); the
+/// others by the same code without those tests.
 #[inline(always)]
 pub fn solve(
     settings: &GaussSeidelSettings,
@@ -36,6 +39,9 @@ pub fn solve(
     lambda: &mut [Vector2<f64>],
     slide: &mut [Slide],
 ) -> Sweeps {
+    if problem.may_be_singular() {
+        return solve_by_sweeps::<true>(settings, problem, lambda, slide);
+    }
     let m = problem.len();
     if m == 1 && settings.local_solve == LocalSolve::Radial && settings.max_sweeps >= 2 {
         if let Some(sweeps) = solve_single_radial(settings, problem, lambda, slide) {
@@ -47,12 +53,12 @@ pub fn solve(
             return sweeps;
         }
     }
-    solve_by_sweeps(settings, problem, lambda, slide)
+    solve_by_sweeps::<false>(settings, problem, lambda, slide)
 }
 
-/// The sweeps of [`solve`] (module documentation).
+/// The sweeps of [`solve`] (module documentation); `SINGULAR` when a block may be singular.
 #[inline(never)]
-fn solve_by_sweeps(
+fn solve_by_sweeps<const SINGULAR: bool>(
     settings: &GaussSeidelSettings,
     problem: &TangentialProblem,
     lambda: &mut [Vector2<f64>],
@@ -65,7 +71,7 @@ fn solve_by_sweeps(
         let mut norm2 = 0.0;
         for (k, slot) in problem.slots().iter().enumerate() {
             let c = problem.local_rhs(k, &lambda[..m]);
-            let (new, st) = local_solve_block(
+            let (new, st) = local_solve_with::<SINGULAR>(
                 problem.diagonal_block(k),
                 &c,
                 slot.s_static,
@@ -84,7 +90,8 @@ fn solve_by_sweeps(
             // The radial local solve does not satisfy Coulomb's law when H_ii is not
             // isotropic: its fixed point is not a zero of the residual, so only the change
             // test applies to it.
-            let r = problem.natural_map_residual_after_sweep(&lambda[..m], &slide[..m]);
+            let r = problem
+                .natural_map_residual_after_sweep_with::<SINGULAR>(&lambda[..m], &slide[..m]);
             residual = Some(r);
             if r <= settings.residual_tolerance || settings.local_solve == LocalSolve::Radial {
                 return Sweeps {
@@ -172,7 +179,8 @@ fn single_sweep(
     let slot = &problem.slots()[0];
     // local_rhs(0, λ) of a single contact: b_0, nothing subtracted
     let c = problem.rhs(0);
-    let (new, st) = local_solve_block(
+    // regular: a singular block is solved by the sweeps (`solve`)
+    let (new, st) = local_solve_with::<false>(
         problem.diagonal_block(0),
         &c,
         slot.s_static,
@@ -200,6 +208,7 @@ pub(crate) mod tests {
 
     use super::*;
     use crate::contact::delassus::Slot;
+    use crate::contact::friction::local_solve_block;
 
     /// One closed contact on 4 modes whose `H_ii` is anisotropic (ratio ~10), sliding: `b` well
     /// outside the static disk.

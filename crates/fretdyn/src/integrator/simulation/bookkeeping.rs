@@ -97,6 +97,28 @@ impl Simulation<'_> {
         non_finite
     }
 
+    /// Opens the statistics window at the end of the current step (THEORY §11): an impact
+    /// under way starts there, with the normal approach speed `−n·(Φ_c q̇ − ḋ)` of its
+    /// contact at that time as its impact speed (the full-step velocities, those of the step
+    /// or at t = 0 the initial ones; the obstacle's full-step velocity, set for the closed
+    /// contacts).
+    #[cold]
+    #[inline(never)]
+    pub(super) fn open_statistics_window(&mut self) {
+        let t = self.step as f64 * self.settings.dt;
+        let (model, surface_rows, qd) = (self.model, &self.surface_rows, &self.cd.qd);
+        let speeds = self.contacts.iter().enumerate().map(|(k, s)| {
+            if !s.closed {
+                return 0.0;
+            }
+            let rows = super::contact_rows(model, surface_rows, k);
+            -s.frame
+                .normal
+                .dot(&(recombine(rows, qd) - s.frame.velocity))
+        });
+        self.statistics.open_window(t, speeds);
+    }
+
     /// The statistics so far, without ending the run (its recorder is empty).
     pub fn partial_results(&self, wall_time: f64) -> RunResults {
         let mut statistics = self.statistics.clone();

@@ -214,6 +214,9 @@ pub struct Simulation<'m> {
     force: Vec<f64>,
     names: Vec<String>,
     statistics: ContactStatisticsState,
+    /// The last step before the statistics window, at whose end the window opens
+    /// ([`Self::open_statistics_window`]; `u64::MAX`: never).
+    window_opens: u64,
     solver_stats: SolverStatistics,
     stable_dt: f64,
     energy: EnergyBalance,
@@ -626,6 +629,10 @@ impl<'m> Simulation<'m> {
                 settings.steps,
                 settings.dt,
             ),
+            window_opens: settings
+                .statistics
+                .first_window_step(settings.steps, settings.dt)
+                .map_or(u64::MAX, |first| first - 1),
             wear_map: None,
             solver_stats: SolverStatistics::default(),
             stable_dt,
@@ -669,6 +676,9 @@ impl<'m> Simulation<'m> {
                 .iter()
                 .map(|c| (c.frame.penetration, c.closed)),
         );
+        if self.window_opens == 0 {
+            self.open_statistics_window();
+        }
         // the initial state is the input's: the steps check what they add
         let _ = self.sample();
     }
@@ -820,6 +830,9 @@ impl<'m> Simulation<'m> {
             .map(|((s, c), rows)| contact_step(s, c, O::rows(rows), t));
         self.statistics
             .step(&self.settings.statistics, t, dt, values);
+        if self.step == self.window_opens {
+            self.open_statistics_window();
+        }
         if let Some(map) = &mut self.wear_map {
             track_wear(
                 map,
