@@ -136,6 +136,9 @@ fn a_coarse_time_step_warns_before_the_run_with_the_one_that_fixes_it() {
     );
     assert!(!w.contains('\n'), "one line: {w}");
     assert!(impact_resolution_warnings(&model, duration / 30.0).is_empty());
+    // at 1.5 steps (above the stable limit 2/ω, π/2 steps) the run is refused: no warning
+    assert!(impact_resolution_warnings(&model, duration / 1.5).is_empty());
+    assert_eq!(impact_resolution_warnings(&model, duration / 1.6).len(), 1);
     let fixed = impact_time_step(&model).unwrap();
     assert_eq!(number_after(w, "at most "), fixed, "{w}");
     let steps = duration / fixed;

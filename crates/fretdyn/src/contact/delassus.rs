@@ -1083,6 +1083,71 @@ mod tests {
         }
     }
 
+    /// Two stick contacts with the same rows (two obstacles on one point): `H_SS` is singular
+    /// along `(d, −d)`. With the same obstacle velocities the right-hand side is consistent
+    /// and the regularised solve sticks both with nearly the minimum-norm forces (equal
+    /// halves to 1e-3, no slip velocity to 1e-9 of `b`); with different ones no λ sticks both,
+    /// and the solve
+    /// returns forces far beyond the static disks, which the Active Set's stick test refuses.
+    #[test]
+    fn a_singular_stick_system_with_an_inconsistent_right_hand_side_does_not_stick() {
+        let (p, contacts) = (4, 2);
+        let a_inv = [0.5, 1.5, 2.0, 0.25];
+        let mut problem = TangentialProblem::new(p, contacts);
+        let tangents = [Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.0, 0.6, 0.8)];
+        let rows: Vec<f64> = (0..3 * p).map(|i| ((i * 5) % 7) as f64 - 2.5).collect();
+        for c in 0..contacts {
+            problem.fix_rows(c, &tangents, &rows, |l, out| {
+                for i in 0..l.len() {
+                    out[i] = a_inv[i] * l[i];
+                }
+            });
+        }
+        let s = 1e3;
+        let (mut work, mut index) = (vec![0.0; 16 + 8], vec![0; 4]);
+        for (other, sticks) in [(Vector2::zeros(), true), (Vector2::new(1e-3, 0.0), false)] {
+            problem.clear();
+            for c in 0..contacts {
+                let slot = Slot {
+                    contact: c,
+                    s_static: s,
+                    s_dynamic: 0.8 * s,
+                };
+                problem.push(slot, &[Vector3::zeros(); 2], &[], &[]);
+            }
+            problem.assemble(
+                &[0.1, -0.2, 0.3, 0.4],
+                &[1.0, 2.0, -1.0, 0.5],
+                1e-3,
+                |slot| {
+                    if slot.contact == 0 {
+                        Vector2::zeros()
+                    } else {
+                        other
+                    }
+                },
+            );
+            let mut lambda = [Vector2::zeros(); 2];
+            assert!(problem.solve_stick(&[true, true], &mut lambda, &mut work, &mut index));
+            let largest = lambda[0].norm().max(lambda[1].norm());
+            if sticks {
+                // along (d, −d) the right-hand side is round-off, a few ε|b|, over the
+                // shift ~1e-11 |H|: equal halves to 1e-3
+                assert!(
+                    (lambda[0] - lambda[1]).norm() <= 1e-3 * largest,
+                    "{lambda:?}"
+                );
+                assert!(largest <= s, "{lambda:?}");
+                for k in 0..2 {
+                    let w = problem.residual_velocity(k, &lambda);
+                    assert!(w.norm() <= 1e-9 * problem.rhs(k).norm(), "w_{k} = {w}");
+                }
+            } else {
+                assert!(largest > 1e3 * s, "{lambda:?} would pass the stick test");
+            }
+        }
+    }
+
     /// The square-root-free pivot test gives the Cholesky's answer: regular for SPD matrices
     /// (down to a smallest eigenvalue 1e-9 of the largest, at scales 1e-6 to 1e6), singular for a
     /// rank-deficient one (two contacts with the same rows), a pivot just below the

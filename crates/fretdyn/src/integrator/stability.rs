@@ -340,9 +340,16 @@ pub fn impact_time_step(model: &Model) -> Option<f64> {
 /// A warning when `dt` resolves some contact's impacts with fewer than
 /// [`MIN_STEPS_PER_IMPACT`] steps ([`impact_resolution`]): one line naming the contacts, the
 /// steps per impact, and the `time.dt` that would resolve every impact with that many
-/// ([`impact_time_step`]).
+/// ([`impact_time_step`]). None when an impact lasts `π/2` steps or fewer: `Δt` is then
+/// at least `2/ω_c ≥ 2/ω_max` (the stable limit, `ω_c = √(K_N/m_eff)` being at most the
+/// highest frequency of the structure with its contacts), and the run is refused with the
+/// limit (THEORY §2).
 pub fn impact_resolution_warnings(model: &Model, dt: f64) -> Vec<String> {
-    let coarse: Vec<ImpactResolution> = impact_resolution(model, dt)
+    let all = impact_resolution(model, dt);
+    if all.iter().any(|r| r.steps <= 0.5 * std::f64::consts::PI) {
+        return Vec::new();
+    }
+    let coarse: Vec<ImpactResolution> = all
         .into_iter()
         .filter(|r| r.steps < MIN_STEPS_PER_IMPACT)
         .collect();
