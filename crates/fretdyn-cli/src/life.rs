@@ -11,6 +11,7 @@ use fretdyn::apps::life::{
     LifeCheckpoint, LifeControl, LifeEnd, LifeResults, LifeStep, YEAR, service_life_with,
 };
 use fretdyn::case::Case;
+use fretdyn::error::number;
 
 use crate::Failure;
 use crate::out::{errln, outln};
@@ -92,9 +93,9 @@ pub fn main(o: &Options) -> Result<(), Failure> {
     outln!(
         "{}: service life to {} years, windows of {} s, depth change ≤ {} per step{}",
         case.title,
-        readable(life.target / YEAR),
-        readable(window),
-        readable(life.max_depth_change),
+        number(life.target / YEAR),
+        number(window),
+        number(life.max_depth_change),
         if life.feedback {
             ""
         } else {
@@ -210,7 +211,7 @@ pub fn main(o: &Options) -> Result<(), Failure> {
         } => Err(Failure::failed(format!(
             "{source}: life: at {}, tube depth {depth:.4e} m, the life step that keeps the depth change of contact '{contact}' within life.max_depth_change is {step:.3e} s, below what the service time resolves there (t + Δt = t): the depth grows too fast there to be followed to {} years; raise life.max_depth_change or life.depth_resolution, or shorten life.target_years (results so far written)",
             when(*time),
-            readable(life.target / YEAR)
+            number(life.target / YEAR)
         ))),
         LifeEnd::Diverged {
             window,
@@ -320,13 +321,6 @@ fn when(t: f64) -> String {
     } else {
         format!("{t:.4e} s")
     }
-}
-
-/// A number computed from the input as a person would write it: 12 significant digits,
-/// then the shortest form (`0.1 + 0.2` → `0.3`).
-fn readable(x: f64) -> String {
-    let rounded: f64 = format!("{x:.11e}").parse().unwrap_or(x);
-    format!("{rounded}")
 }
 
 /// The life again with `max_depth_change` halved `halvings` times: the tube's depth at the

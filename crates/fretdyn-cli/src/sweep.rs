@@ -48,8 +48,18 @@ pub fn main(
     }
     let s = Study::from_file(study).map_err(|e| Failure::input(e.in_file(study)))?;
     // every run's case is built and checked before anything is run or written
-    s.check(jobs)
+    let warnings = s
+        .check(jobs)
         .map_err(|e| Failure::input(format!("{}; nothing was run", e.in_file(study))))?;
+    let runs = s.runs().len();
+    for (w, n) in &warnings {
+        let which = if *n == runs {
+            "every run".to_string()
+        } else {
+            format!("{n} of {runs} runs")
+        };
+        errln!("warning: {} ({which}): {w}", study.display());
+    }
     let dir = output.unwrap_or_else(|| {
         let stem = study
             .file_stem()

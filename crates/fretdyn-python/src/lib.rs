@@ -191,6 +191,12 @@ fn dict_error(doc: &Document, e: fretdyn::Error) -> PyErr {
 /// at none.
 fn dict_error_at(doc: &Document, e: fretdyn::Error) -> (Option<String>, String) {
     match e {
+        // the key as the case's TOML writes it is the dict's key path
+        fretdyn::Error::Parse {
+            key: Some(key),
+            message,
+            ..
+        } => (Some(key), message),
         fretdyn::Error::Parse { line, message, .. } => (doc.path_at(line, &message), message),
         fretdyn::Error::Invalid { field, message } => (Some(field), message),
         other => (None, other.to_string()),

@@ -755,27 +755,42 @@ impl Study {
     /// Builds the case of every run and checks it as a run would (the stability limit of
     /// Δt included), `jobs` at a time (0: one per core), so that a value that makes a case
     /// invalid is found before any run starts. The error is that of the first such run, as
-    /// [`Error::StudyRun`] naming it and its values.
-    pub fn check(&self, jobs: usize) -> Result<()> {
+    /// [`Error::StudyRun`] naming it and its values. Returns the cases' warnings (an
+    /// implausible value, an impact resolved by too few steps…), each once with the number of
+    /// runs that give it, in the order of the runs.
+    pub fn check(&self, jobs: usize) -> Result<Vec<(String, usize)>> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(jobs)
             .build()
             .map_err(|e| Error::invalid("jobs", e.to_string()))?;
         use rayon::prelude::*;
         let runs = self.runs();
-        let first = pool.install(|| {
-            runs.par_iter().find_map_first(|run| {
-                self.case(run)
-                    .and_then(|case| Simulation::check(&case.model, &case.settings))
-                    .err()
-                    .map(|e| Error::StudyRun {
-                        index: run.index,
-                        point: self.describe(run),
-                        source: Box::new(e),
-                    })
-            })
+        let checked: Vec<Result<Vec<String>>> = pool.install(|| {
+            runs.par_iter()
+                .map(|run| {
+                    self.case(run)
+                        .and_then(|case| {
+                            Simulation::check(&case.model, &case.settings)?;
+                            Ok(case.warnings)
+                        })
+                        .map_err(|e| Error::StudyRun {
+                            index: run.index,
+                            point: self.describe(run),
+                            source: Box::new(e),
+                        })
+                })
+                .collect()
         });
-        first.map_or(Ok(()), Err)
+        let mut warnings: Vec<(String, usize)> = Vec::new();
+        for run in checked {
+            for w in run? {
+                match warnings.iter_mut().find(|(text, _)| *text == w) {
+                    Some((_, n)) => *n += 1,
+                    None => warnings.push((w, 1)),
+                }
+            }
+        }
+        Ok(warnings)
     }
 
     /// Runs every run not already in the table at `table` (created with its header if

@@ -370,6 +370,15 @@ fn drive(
     Ok(results)
 }
 
+/// A zip error as the I/O error it is (a full disk says "No space left on device", not "i/o
+/// error"), or wrapped.
+fn zip_io(e: zip::result::ZipError) -> std::io::Error {
+    match e {
+        zip::result::ZipError::Io(e) => e,
+        other => std::io::Error::other(other),
+    }
+}
+
 /// Statistics so far, without touching the run.
 fn partial(sim: &Simulation, start: Instant) -> RunResults {
     sim.partial_results(start.elapsed().as_secs_f64())
@@ -635,11 +644,11 @@ impl Files {
                 .large_file(true);
             for (key, p) in &series {
                 zip.start_file(format!("{key}.npy"), options)
-                    .map_err(std::io::Error::other)?;
+                    .map_err(zip_io)?;
                 let mut f = File::open(p)?;
                 std::io::copy(&mut f, &mut zip)?;
             }
-            zip.finish().map_err(std::io::Error::other)?.flush()
+            zip.finish().map_err(zip_io)?.flush()
         })?;
         #[cfg(feature = "netcdf")]
         {
