@@ -652,6 +652,17 @@ fn schema_errors_name_the_key_and_say_what_is_expected_in_plain_words() {
             "output.every",
             &["a whole number ≥ 1", "got -1"],
         ),
+        // an unknown key inside a tagged table is reported at the table: named with it
+        (
+            V1A,
+            "gap = 0.0, tangent",
+            "gap = 0.0, clearance = 2e-4, tangent",
+            "contacts[0].obstacle.clearance",
+            &[
+                "unknown key",
+                "the keys of contacts[0].obstacle are origin, normal, gap, tangent",
+            ],
+        ),
         (
             V1A,
             "every = 1 ",

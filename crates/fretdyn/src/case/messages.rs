@@ -436,7 +436,13 @@ fn plain_words(message: &str, place: Option<&Place>) -> (Option<String>, String)
     }
     if let Some(rest) = message.strip_prefix("unknown field `") {
         if let Some((field, known)) = rest.split_once('`') {
-            let key = key.unwrap_or_else(|| field.to_string());
+            // a tagged table (`obstacle = { type = …, … }`) reports its unknown key at the
+            // table: the key is the table's path and the field
+            let key = match key {
+                Some(k) if k == field || k.ends_with(&format!(".{field}")) => k,
+                Some(k) => join(&k, field),
+                None => field.to_string(),
+            };
             let parent = match key.rsplit_once('.') {
                 Some((parent, _)) => parent.to_string(),
                 None => "the file".to_string(),
