@@ -473,10 +473,17 @@ fn sweep_writes_the_largest_connors_ratio_and_warns_once() {
     assert!(!stderr.contains("Connors"), "{stderr}");
     let table = std::fs::read_to_string(s.0.join("bare/study.csv")).unwrap();
     let mut lines = table.lines();
-    assert!(lines.next().unwrap().ends_with(",connors_max_ratio"));
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .ends_with(",connors_max_ratio,fingerprint")
+    );
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 2);
     for r in rows {
-        assert!(r.ends_with(','), "{r}");
+        // the ratio empty, then the row's fingerprint
+        let cells: Vec<&str> = r.rsplitn(3, ',').collect();
+        assert!(cells[0].starts_with("fp") && cells[1].is_empty(), "{r}");
     }
 }
