@@ -70,10 +70,9 @@ fn read_peaks(dir: &Path, contacts: usize) -> Vec<Vec<f64>> {
             if let (Some(Ok(k)), Some(Ok(p))) = (
                 cols.first().map(|c| c.parse::<usize>()),
                 cols.get(6).map(|c| c.parse::<f64>()),
-            ) {
-                if k < contacts {
-                    peaks[k].push(p);
-                }
+            ) && k < contacts
+            {
+                peaks[k].push(p);
             }
         }
     }

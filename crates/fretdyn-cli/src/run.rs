@@ -491,14 +491,14 @@ pub fn error_warnings(case: &Case, r: &RunResults) -> Vec<String> {
             ));
         }
     }
-    if let (Some(target), None) = (st.target_relative_error, r.target_met_at) {
-        if matches!(r.termination, Termination::Completed) {
-            out.push(format!(
+    if let (Some(target), None) = (st.target_relative_error, r.target_met_at)
+        && matches!(r.termination, Termination::Completed)
+    {
+        out.push(format!(
                 "the target relative error {} % (statistics.target_relative_error) was not met within time.duration = {} s; the run went to its end",
                 number(100.0 * target),
                 number(r.steps as f64 * r.dt)
             ));
-        }
     }
     out
 }

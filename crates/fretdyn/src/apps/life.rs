@@ -441,7 +441,7 @@ enum WindowEnd {
     /// Diverged at this step of the window, at this contact.
     Diverged(u64, Option<String>),
     /// Stopped from outside at the end of a batch: where it stood.
-    Stopped(WindowProgress),
+    Stopped(Box<WindowProgress>),
 }
 
 /// A window under way: its simulation's state and where its wear work was done so far, at
@@ -490,7 +490,7 @@ fn window(
         }
     })?;
     if let Some(progress) = stopped {
-        return Ok(WindowEnd::Stopped(progress));
+        return Ok(WindowEnd::Stopped(Box::new(progress)));
     }
     let map = map.expect("tracked");
     if let Termination::Diverged { step, contact, .. } = results.termination {
@@ -1012,7 +1012,7 @@ pub fn service_life_with(
                         break;
                     }
                     WindowEnd::Stopped(progress) => {
-                        state.window = Some(progress);
+                        state.window = Some(*progress);
                         save(&state, &start)?;
                         end = LifeEnd::Stopped { time: t };
                         break;

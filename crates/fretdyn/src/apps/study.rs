@@ -608,12 +608,12 @@ impl Study {
             set_path(&mut value, &c.key, v)
                 .map_err(|e| Error::invalid(c.key.clone(), e.to_string()))?;
         }
-        if let Some(seed) = run.seed {
-            if let Some(toml::Value::Array(loads)) = value.get_mut("turbulence") {
-                for l in loads {
-                    if let Some(t) = l.as_table_mut() {
-                        t.insert("seed".into(), toml::Value::Integer(seed as i64));
-                    }
+        if let Some(seed) = run.seed
+            && let Some(toml::Value::Array(loads)) = value.get_mut("turbulence")
+        {
+            for l in loads {
+                if let Some(t) = l.as_table_mut() {
+                    t.insert("seed".into(), toml::Value::Integer(seed as i64));
                 }
             }
         }
@@ -925,15 +925,16 @@ impl Study {
         }
         let done = self.checked_rows(table, &header, &expected, &runs)?;
         // a row cut by a crash is dropped (its run is done again)
-        if let Ok(text) = std::fs::read(table) {
-            if !text.is_empty() && !text.ends_with(b"\n") {
-                let keep = text.iter().rposition(|b| *b == b'\n').map_or(0, |i| i + 1);
-                let f = std::fs::OpenOptions::new()
-                    .write(true)
-                    .open(table)
-                    .map_err(|e| Error::io(table, e))?;
-                f.set_len(keep as u64).map_err(|e| Error::io(table, e))?;
-            }
+        if let Ok(text) = std::fs::read(table)
+            && !text.is_empty()
+            && !text.ends_with(b"\n")
+        {
+            let keep = text.iter().rposition(|b| *b == b'\n').map_or(0, |i| i + 1);
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(table)
+                .map_err(|e| Error::io(table, e))?;
+            f.set_len(keep as u64).map_err(|e| Error::io(table, e))?;
         }
         let mut file = std::fs::OpenOptions::new()
             .create(true)
@@ -1460,7 +1461,7 @@ pub fn statistics_run_from(
         if sim.recorder().is_full() {
             sim.recorder_mut().clear();
         }
-        if sim.steps_done() % Simulation::BATCH == 0 {
+        if sim.steps_done().is_multiple_of(Simulation::BATCH) {
             let statistics = sim.statistics_mut();
             statistics.impacts.clear();
             statistics.blocks.clear();

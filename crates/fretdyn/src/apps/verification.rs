@@ -276,12 +276,13 @@ pub fn measure(v1: &V1, results: &RunResults) -> V1Measurements {
                 m.slip_direction_error = m.slip_direction_error.max(e);
             }
         }
-        if let Some(ts) = ts {
-            if t >= ts + 2.0 * dt && status != 0 {
-                m.post_stick_force = m.post_stick_force.max(rt.norm());
-                if status == 2 {
-                    m.post_stick_slip_samples += 1;
-                }
+        if let Some(ts) = ts
+            && t >= ts + 2.0 * dt
+            && status != 0
+        {
+            m.post_stick_force = m.post_stick_force.max(rt.norm());
+            if status == 2 {
+                m.post_stick_slip_samples += 1;
             }
         }
     }

@@ -510,19 +510,19 @@ impl ZoneSection {
         let velocity = velocity.scaled(factor);
         velocity.validate(&vfield)?;
         let stations = line.stations(s0, s1, model);
-        if let Line::Points(a) = line {
-            if stations.len() < 2 {
-                return Err(Error::invalid(
-                    format!("{field}.{key}"),
-                    format!(
-                        "[{}, {}] m holds {} point(s) with an abscissa: at least 2 are needed to integrate along the zone (give more points, with {})",
-                        number(s0),
-                        number(s1),
-                        stations.len(),
-                        a.source
-                    ),
-                ));
-            }
+        if let Line::Points(a) = line
+            && stations.len() < 2
+        {
+            return Err(Error::invalid(
+                format!("{field}.{key}"),
+                format!(
+                    "[{}, {}] m holds {} point(s) with an abscissa: at least 2 are needed to integrate along the zone (give more points, with {})",
+                    number(s0),
+                    number(s1),
+                    stations.len(),
+                    a.source
+                ),
+            ));
         }
         let fluid_elastic = match &self.fluid_elastic {
             Some(f) => Some(f.build(&format!("{field}.fluid_elastic"), &stations)?),

@@ -419,85 +419,84 @@ fn plain_words(message: &str, place: Option<&Place>) -> (Option<String>, String)
     if let Some(rest) = ["invalid type: ", "invalid value: "]
         .iter()
         .find_map(|p| message.strip_prefix(p))
+        && let Some((unexpected, expected)) = rest.rsplit_once(", expected ")
     {
-        if let Some((unexpected, expected)) = rest.rsplit_once(", expected ") {
-            let got = written.unwrap_or_else(|| unexpected_words(unexpected));
-            return (key, format!("must be {}, got {got}", expected_of(expected)));
-        }
+        let got = written.unwrap_or_else(|| unexpected_words(unexpected));
+        return (key, format!("must be {}, got {got}", expected_of(expected)));
     }
-    if let Some(rest) = message.strip_prefix("invalid length ") {
-        if let Some((n, expected)) = rest.split_once(", expected ") {
-            let got = written.unwrap_or_else(|| format!("a list of {n}"));
-            return (
-                key,
-                format!("must be {}, got {got}", expected_words(expected)),
-            );
-        }
+    if let Some(rest) = message.strip_prefix("invalid length ")
+        && let Some((n, expected)) = rest.split_once(", expected ")
+    {
+        let got = written.unwrap_or_else(|| format!("a list of {n}"));
+        return (
+            key,
+            format!("must be {}, got {got}", expected_words(expected)),
+        );
     }
-    if let Some(rest) = message.strip_prefix("unknown field `") {
-        if let Some((field, known)) = rest.split_once('`') {
-            // a tagged table (`obstacle = { type = …, … }`) reports its unknown key at the
-            // table: the key is the table's path and the field
-            let key = match key {
-                Some(k) if k == field || k.ends_with(&format!(".{field}")) => k,
-                Some(k) => join(&k, field),
-                None => field.to_string(),
-            };
-            let parent = match key.rsplit_once('.') {
-                Some((parent, _)) => parent.to_string(),
-                None => "the file".to_string(),
-            };
-            let known = names(known);
-            let message = if known.is_empty() {
-                format!("unknown key: {parent} takes no keys")
+    if let Some(rest) = message.strip_prefix("unknown field `")
+        && let Some((field, known)) = rest.split_once('`')
+    {
+        // a tagged table (`obstacle = { type = …, … }`) reports its unknown key at the
+        // table: the key is the table's path and the field
+        let key = match key {
+            Some(k) if k == field || k.ends_with(&format!(".{field}")) => k,
+            Some(k) => join(&k, field),
+            None => field.to_string(),
+        };
+        let parent = match key.rsplit_once('.') {
+            Some((parent, _)) => parent.to_string(),
+            None => "the file".to_string(),
+        };
+        let known = names(known);
+        let message = if known.is_empty() {
+            format!("unknown key: {parent} takes no keys")
+        } else {
+            format!(
+                "unknown key (check its spelling): the keys of {parent} are {}",
+                known.join(", ")
+            )
+        };
+        return (Some(key), message);
+    }
+    if let Some(rest) = message.strip_prefix("unknown variant `")
+        && let Some((variant, known)) = rest.split_once('`')
+    {
+        let known: Vec<String> = names(known).iter().map(|n| format!("\"{n}\"")).collect();
+        let got = written.unwrap_or_else(|| format!("\"{variant}\""));
+        return (
+            key,
+            match known.len() {
+                0 => format!("takes no value here, got {got}"),
+                1 => format!("must be {}, got {got}", known[0]),
+                _ => format!("must be one of {}, got {got}", known.join(", ")),
+            },
+        );
+    }
+    if let Some(rest) = message.strip_prefix("missing field `")
+        && let Some((field, _)) = rest.split_once('`')
+    {
+        let (key, table) = match key {
+            // a section: [time]
+            Some(k) if !k.contains(['.', '[']) => (format!("{k}.{field}"), format!("[{k}]")),
+            Some(k) => (format!("{k}.{field}"), k),
+            None => (field.to_string(), "the file".to_string()),
+        };
+        return (
+            Some(key),
+            format!("is missing: add {field} = … to {table} (the examples show its meaning)"),
+        );
+    }
+    if let Some(rest) = message.strip_prefix("duplicate field `")
+        && let Some((field, _)) = rest.split_once('`')
+    {
+        let key = key.map_or(field.to_string(), |k| {
+            if k.ends_with(field) {
+                k
             } else {
-                format!(
-                    "unknown key (check its spelling): the keys of {parent} are {}",
-                    known.join(", ")
-                )
-            };
-            return (Some(key), message);
-        }
-    }
-    if let Some(rest) = message.strip_prefix("unknown variant `") {
-        if let Some((variant, known)) = rest.split_once('`') {
-            let known: Vec<String> = names(known).iter().map(|n| format!("\"{n}\"")).collect();
-            let got = written.unwrap_or_else(|| format!("\"{variant}\""));
-            return (
-                key,
-                match known.len() {
-                    0 => format!("takes no value here, got {got}"),
-                    1 => format!("must be {}, got {got}", known[0]),
-                    _ => format!("must be one of {}, got {got}", known.join(", ")),
-                },
-            );
-        }
-    }
-    if let Some(rest) = message.strip_prefix("missing field `") {
-        if let Some((field, _)) = rest.split_once('`') {
-            let (key, table) = match key {
-                // a section: [time]
-                Some(k) if !k.contains(['.', '[']) => (format!("{k}.{field}"), format!("[{k}]")),
-                Some(k) => (format!("{k}.{field}"), k),
-                None => (field.to_string(), "the file".to_string()),
-            };
-            return (
-                Some(key),
-                format!("is missing: add {field} = … to {table} (the examples show its meaning)"),
-            );
-        }
-    }
-    if let Some(rest) = message.strip_prefix("duplicate field `") {
-        if let Some((field, _)) = rest.split_once('`') {
-            let key = key.map_or(field.to_string(), |k| {
-                if k.ends_with(field) {
-                    k
-                } else {
-                    format!("{k}.{field}")
-                }
-            });
-            return (Some(key), "is given twice: keep one".to_string());
-        }
+                format!("{k}.{field}")
+            }
+        });
+        return (Some(key), "is given twice: keep one".to_string());
     }
     if let Some(name) = message.strip_prefix("data did not match any variant of untagged enum ") {
         let expected = match UNTAGGED.iter().find(|(n, _, _)| *n == name.trim()) {

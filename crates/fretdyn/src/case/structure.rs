@@ -518,13 +518,13 @@ impl StructureSection {
                         abscissae.source = "s = … (m) on the points of [structure]".into();
                     }
                     abscissae.s.resize(basis.points.len(), None);
-                    if let Some(s) = pt.s {
-                        if !s.is_finite() {
-                            return Err(Error::invalid(
-                                format!("structure.points[{j}].s"),
-                                format!("must be a finite abscissa in m (got {})", number(s)),
-                            ));
-                        }
+                    if let Some(s) = pt.s
+                        && !s.is_finite()
+                    {
+                        return Err(Error::invalid(
+                            format!("structure.points[{j}].s"),
+                            format!("must be a finite abscissa in m (got {})", number(s)),
+                        ));
                     }
                     abscissae.s.push(pt.s);
                     basis.points.push(Point {

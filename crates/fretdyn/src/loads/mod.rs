@@ -314,7 +314,7 @@ impl TurbulentLoad {
 
     /// Checks the vectors against the basis size and the spectrum.
     pub fn validate(&self, modes: usize, field: &str) -> Result<()> {
-        if modes == 0 || self.rows.is_empty() || self.rows.len() % modes != 0 {
+        if modes == 0 || self.rows.is_empty() || !self.rows.len().is_multiple_of(modes) {
             return Err(Error::invalid(
                 format!("{field}.rows"),
                 format!("must hold one row of {modes} values per channel"),

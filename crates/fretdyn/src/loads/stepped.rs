@@ -121,7 +121,7 @@ impl<'a> SteppedHistory<'a> {
     /// The value at step `n`, time `t = n Δt` (as the step forms it: `n as f64 * Δt`).
     #[inline(always)]
     pub fn value(&mut self, n: u64, t: f64) -> f64 {
-        let follows = self.at.is_some_and(|m| m + 1 == n) && n % ANCHOR_STEPS != 0;
+        let follows = self.at.is_some_and(|m| m + 1 == n) && !n.is_multiple_of(ANCHOR_STEPS);
         // (a harmonic history's one sine apart: as a slice of one, its loop costs ~35
         // instructions per step)
         let value = match &mut self.terms {

@@ -295,24 +295,24 @@ impl GeneratorSettings {
                 ),
             ));
         }
-        if let Some(l) = self.filter_length {
-            if !(MIN_FILTER_LENGTH..=MAX_FILTER_LENGTH).contains(&l) {
-                return Err(Error::invalid(
-                    format!("{field}.filter_length"),
-                    format!(
-                        "must be between {MIN_FILTER_LENGTH} and {MAX_FILTER_LENGTH} taps \
+        if let Some(l) = self.filter_length
+            && !(MIN_FILTER_LENGTH..=MAX_FILTER_LENGTH).contains(&l)
+        {
+            return Err(Error::invalid(
+                format!("{field}.filter_length"),
+                format!(
+                    "must be between {MIN_FILTER_LENGTH} and {MAX_FILTER_LENGTH} taps \
                          (got {l}); leave it unset to choose it from the spectrum"
-                    ),
-                ));
-            }
+                ),
+            ));
         }
-        if let Some(b) = self.block_length {
-            if !(1..=MAX_BLOCK_LENGTH).contains(&b) {
-                return Err(Error::invalid(
-                    format!("{field}.block_length"),
-                    format!("must be between 1 and {MAX_BLOCK_LENGTH} samples (got {b})"),
-                ));
-            }
+        if let Some(b) = self.block_length
+            && !(1..=MAX_BLOCK_LENGTH).contains(&b)
+        {
+            return Err(Error::invalid(
+                format!("{field}.block_length"),
+                format!("must be between 1 and {MAX_BLOCK_LENGTH} samples (got {b})"),
+            ));
         }
         Ok(())
     }

@@ -87,31 +87,29 @@ impl StatisticsSettings {
                 ),
             ));
         }
-        if let Some(b) = self.block {
-            if !(b.is_finite() && b > 0.0) {
-                return Err(Error::invalid(
-                    format!("{field}.block"),
-                    format!("must be a positive duration in s (got {b})"),
-                ));
-            }
+        if let Some(b) = self.block
+            && !(b.is_finite() && b > 0.0)
+        {
+            return Err(Error::invalid(
+                format!("{field}.block"),
+                format!("must be a positive duration in s (got {b})"),
+            ));
         }
-        if let Some(n) = self.batches {
-            if n < 2 {
-                return Err(Error::invalid(
-                    format!("{field}.batches"),
-                    format!("must be at least 2 batches to estimate an error (got {n})"),
-                ));
-            }
+        if let Some(n) = self.batches
+            && n < 2
+        {
+            return Err(Error::invalid(
+                format!("{field}.batches"),
+                format!("must be at least 2 batches to estimate an error (got {n})"),
+            ));
         }
-        if let Some(e) = self.target_relative_error {
-            if !(e.is_finite() && e > 0.0 && e < 1.0) {
-                return Err(Error::invalid(
-                    format!("{field}.target_relative_error"),
-                    format!(
-                        "must be a relative standard error in (0, 1), e.g. 0.02 for 2 % (got {e})"
-                    ),
-                ));
-            }
+        if let Some(e) = self.target_relative_error
+            && !(e.is_finite() && e > 0.0 && e < 1.0)
+        {
+            return Err(Error::invalid(
+                format!("{field}.target_relative_error"),
+                format!("must be a relative standard error in (0, 1), e.g. 0.02 for 2 % (got {e})"),
+            ));
         }
         if !(self.max_relative_error.is_finite() && self.max_relative_error > 0.0) {
             return Err(Error::invalid(
@@ -321,14 +319,16 @@ impl ImpactTracker {
         rest: f64,
         in_window: bool,
     ) -> (bool, Option<Impact>) {
-        if v.closed && self.active && !self.open {
-            if let Some(imp) = &mut self.current {
-                let dt = v.t - self.previous_t;
-                Self::add_closed(imp, &mut self.peak_direction, v, dt);
-                self.previous_penetration = v.penetration;
-                self.previous_t = v.t;
-                return (false, None);
-            }
+        if v.closed
+            && self.active
+            && !self.open
+            && let Some(imp) = &mut self.current
+        {
+            let dt = v.t - self.previous_t;
+            Self::add_closed(imp, &mut self.peak_direction, v, dt);
+            self.previous_penetration = v.penetration;
+            self.previous_t = v.t;
+            return (false, None);
         }
         self.step_in_general(contact, v, rest, in_window)
     }
@@ -1349,12 +1349,13 @@ impl ContactStatisticsState {
         }
         self.window_steps += steps;
         self.block_steps = 0;
-        if whole && t.is_finite() && self.target_met.is_none() {
-            if let Some(target) = self.target {
-                if self.target_reached(target) {
-                    self.target_met = Some(t);
-                }
-            }
+        if whole
+            && t.is_finite()
+            && self.target_met.is_none()
+            && let Some(target) = self.target
+            && self.target_reached(target)
+        {
+            self.target_met = Some(t);
         }
     }
 
@@ -1442,11 +1443,11 @@ fn impact_step(
     if in_window && started {
         block.impacts += 1;
     }
-    if let Some(imp) = finished {
-        if tracker.in_window {
-            block.add_impact(&imp);
-            impacts.push(imp);
-        }
+    if let Some(imp) = finished
+        && tracker.in_window
+    {
+        block.add_impact(&imp);
+        impacts.push(imp);
     }
 }
 

@@ -325,8 +325,8 @@ fn drive(
         let n = sim.steps_done();
         let by_steps = stream
             .checkpoint_every_steps
-            .is_some_and(|every| every > 0 && n % every == 0);
-        if n % Simulation::BATCH == 0 || by_steps {
+            .is_some_and(|every| every > 0 && n.is_multiple_of(every));
+        if n.is_multiple_of(Simulation::BATCH) || by_steps {
             let by_time = stream
                 .checkpoint_every_seconds
                 .is_some_and(|s| last_checkpoint.elapsed().as_secs_f64() >= s);
@@ -335,7 +335,7 @@ fn drive(
                 last_checkpoint = Instant::now();
                 observer.checkpoint(&partial(&sim, start));
             }
-            if n % Simulation::BATCH == 0
+            if n.is_multiple_of(Simulation::BATCH)
                 && n < total
                 && observer.progress(Progress { step: n, total }).is_break()
             {

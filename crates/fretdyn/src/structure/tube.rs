@@ -68,15 +68,15 @@ impl TubeStructure {
     pub fn modal_basis(&self) -> Result<TubeBasis> {
         let assembled = self.beam.assemble()?;
         let n = assembled.mass.nrows();
-        if let ModeSelection::Count(count) = self.selection {
-            if count > n {
-                return Err(Error::invalid(
-                    "structure.modes",
-                    format!(
-                        "{count} modes asked, but the tube has {n} free DOFs, hence {n} modes: set modes ≤ {n} (all of them), or refine mesh_size for more"
-                    ),
-                ));
-            }
+        if let ModeSelection::Count(count) = self.selection
+            && count > n
+        {
+            return Err(Error::invalid(
+                "structure.modes",
+                format!(
+                    "{count} modes asked, but the tube has {n} free DOFs, hence {n} modes: set modes ≤ {n} (all of them), or refine mesh_size for more"
+                ),
+            ));
         }
         let modes = lowest_modes(&assembled.mass, &assembled.stiffness, self.selection)
             .map_err(|e| match e {

@@ -43,15 +43,19 @@ pub fn solve(
         return solve_by_sweeps::<true>(settings, problem, lambda, slide);
     }
     let m = problem.len();
-    if m == 1 && settings.local_solve == LocalSolve::Radial && settings.max_sweeps >= 2 {
-        if let Some(sweeps) = solve_single_radial(settings, problem, lambda, slide) {
-            return sweeps;
-        }
+    if m == 1
+        && settings.local_solve == LocalSolve::Radial
+        && settings.max_sweeps >= 2
+        && let Some(sweeps) = solve_single_radial(settings, problem, lambda, slide)
+    {
+        return sweeps;
     }
-    if m == 1 && settings.local_solve == LocalSolve::Exact && settings.max_sweeps >= 2 {
-        if let Some(sweeps) = solve_single_exact(settings, problem, lambda, slide) {
-            return sweeps;
-        }
+    if m == 1
+        && settings.local_solve == LocalSolve::Exact
+        && settings.max_sweeps >= 2
+        && let Some(sweeps) = solve_single_exact(settings, problem, lambda, slide)
+    {
+        return sweeps;
     }
     solve_by_sweeps::<false>(settings, problem, lambda, slide)
 }

@@ -14,17 +14,17 @@ impl Simulation<'_> {
     /// not formed ([`Lanes::free_acceleration_plus`]: the same bits).
     #[inline(always)]
     pub(super) fn free_acceleration<K: Lanes, O: ContactKinds>(&mut self) {
-        if let (true, &[k]) = (O::COMMON, self.closed.as_slice()) {
-            if let Some(rows) = O::rows(&self.frame_rows[k]) {
-                let state = &self.contacts[k];
-                debug_assert_eq!(state.tangential_force, nalgebra::Vector2::zeros());
-                let (s, row) = rows.normal_projection(&state.frame.normal, state.normal_force);
-                if self
-                    .cd
-                    .free_acceleration_plus_with::<K>(&self.external, s, row)
-                {
-                    return;
-                }
+        if let (true, &[k]) = (O::COMMON, self.closed.as_slice())
+            && let Some(rows) = O::rows(&self.frame_rows[k])
+        {
+            let state = &self.contacts[k];
+            debug_assert_eq!(state.tangential_force, nalgebra::Vector2::zeros());
+            let (s, row) = rows.normal_projection(&state.frame.normal, state.normal_force);
+            if self
+                .cd
+                .free_acceleration_plus_with::<K>(&self.external, s, row)
+            {
+                return;
             }
         }
         self.contact_forces::<K, O>();
