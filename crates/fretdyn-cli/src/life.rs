@@ -80,6 +80,10 @@ pub fn main(o: &Options) -> Result<(), Failure> {
         )));
     };
     let (fingerprint, _) = crate::run::fingerprint_of(&path)?;
+    // a case that cannot have a life, or cannot start its first window, is refused before
+    // anything is written
+    fretdyn::apps::life::check_life(&case, &life).map_err(|e| Failure::input(e.in_file(&path)))?;
+    crate::run::check_start(&case, &path)?;
     let _lock = crate::folder::lock(&dir, "life")?;
     let checkpoint = dir.join(CHECKPOINT_FILE);
     let resume = match &o.resume {

@@ -50,8 +50,7 @@ pub fn main(case: Option<&Path>, resume: Option<&Path>, options: &Options) -> Re
                 .unwrap_or_else(|| default_dir(&case.title, path));
             let (fingerprint, text) = fingerprint_of(path)?;
             // bad input is refused before anything is written
-            fretdyn::integrator::simulation::Simulation::check(&case.model, &case.settings)
-                .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+            check_start(&case, path)?;
             check_disk(&case, path, &dir)?;
             let _lock = crate::folder::lock(&dir, "run")?;
             let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
@@ -98,6 +97,16 @@ fn load(path: &Path) -> Result<Case, Failure> {
         }
     }
     Ok(case)
+}
+
+/// Refuses a case that cannot start, before anything is written: what a run checks as it
+/// starts — the stable time step, the energy of the initial state, the memory of the
+/// fluid-elastic delays — not the time step only (an initial state whose energy overflows
+/// left the output folder and its `run.json` behind). The simulation is set up, then dropped.
+pub fn check_start(case: &Case, path: &Path) -> Result<(), Failure> {
+    fretdyn::integrator::simulation::Simulation::with_recorder(&case.model, &case.settings, 1)
+        .map(drop)
+        .map_err(|e| Failure::input(format!("{}: {e}", path.display())))
 }
 
 /// The time histories a streamed run writes, bytes: its samples (`steps / output.every + 1`)

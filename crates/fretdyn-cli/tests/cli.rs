@@ -1063,6 +1063,70 @@ fn a_study_file_given_to_run_says_to_use_sweep() {
     assert!(!stderr.contains("unknown field"), "{stderr}");
 }
 
+/// A case that cannot start — an initial state whose energy overflows, found by the commands'
+/// fuzz test — and a life without a wearing contact are refused by `run`, `life` and `sweep`
+/// before anything is written (exit code 2, one line, no output folder): `run` and `life` left
+/// their folder (`run.json`, `life_run.json`) behind, and `sweep` passed its check, then failed
+/// at its first run with exit code 1, as if a run had failed.
+#[test]
+fn a_case_that_cannot_start_is_refused_before_anything_is_written() {
+    let bad = V1A.replace(
+        "velocity = [0.3420201433256687, 0.0, -0.9396926207859084]",
+        "velocity = [0.3420201433256687, 1e300, -0.9396926207859084]",
+    );
+    let wear = "friction = { mu = 0.3 }
+wear = { tube = { law = \"archard\", coefficient = 2e-15 }, support = { law = \"archard\", coefficient = 1e-15 }, scar = { type = \"flat_bar\", width = 0.02, tube_radius = 0.0095 } }";
+    let life = "\n[life]\ntarget_years = 1.0\n";
+    let s = Scratch::new("cannot_start");
+    for (name, text, args, needles) in [
+        (
+            "run.toml",
+            bad.clone(),
+            vec!["run", "run.toml", "-o", "out"],
+            vec!["run.toml: initial:", "energy of inf J"],
+        ),
+        (
+            "life.toml",
+            format!("{}{life}", bad.replace("friction = { mu = 0.3 }", wear)),
+            vec!["life", "life.toml", "-o", "out"],
+            vec!["life.toml: initial:", "energy of inf J"],
+        ),
+        (
+            "unworn.toml",
+            format!("{V1A}{life}"),
+            vec!["life", "unworn.toml", "-o", "out"],
+            vec!["unworn.toml: life: no contact has a wear law"],
+        ),
+        (
+            "case.toml",
+            bad.clone(),
+            vec!["sweep", "study.toml", "-o", "out"],
+            vec!["study.toml: run 0 (", "initial:", "nothing was run"],
+        ),
+    ] {
+        std::fs::write(s.0.join(name), text).unwrap();
+        std::fs::write(
+            s.0.join("study.toml"),
+            "base = \"case.toml\"\n\n[[parameters]]\nkey = \"contacts.*.friction.mu\"\nvalues = [0.1, 0.2]\n",
+        )
+        .unwrap();
+        let out = fretdyn(&args, &s.0);
+        // the warning on the implausible velocity, then the error in one line
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        let error = stderr.trim_end().lines().last().unwrap_or_default();
+        assert!(error.starts_with("error: "), "{stderr}");
+        assert!(
+            stderr.lines().rev().skip(1).all(|l| l.starts_with("warning: ")),
+            "{stderr}"
+        );
+        for n in &needles {
+            assert!(error.contains(n), "'{n}' not in: {stderr}");
+        }
+        assert!(!s.0.join("out").exists(), "{args:?}: output written");
+    }
+}
+
 /// A value that makes one run invalid: exit 2 before any run, naming the run, its values and
 /// the field; nothing written.
 #[test]

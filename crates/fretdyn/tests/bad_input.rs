@@ -124,6 +124,28 @@ fn two_contacts_with_the_same_name_are_refused() {
     assert!(Case::from_toml_str(&with_second_contact("name = \"other\""), Path::new(".")).is_ok());
 }
 
+/// A contact name heads columns of `study.csv` and `life.csv` (`<name>.wear_work_rate`): a
+/// comma in it (found by the commands' fuzz test: a name taken from a title) gave a header of
+/// more columns than the rows, and the sweep refused its own first row (exit code 1). A comma,
+/// a double quote or a line break is refused, naming the key; other characters are not.
+#[test]
+fn a_contact_name_that_would_cut_the_output_tables_is_refused() {
+    for name in ["plate, upper", "plate \\\"3\\\"", "plate\\n3"] {
+        let (field, message) = invalid(&replace_once(
+            V1A,
+            "name = \"plane\"",
+            &format!("name = \"{name}\""),
+        ));
+        assert_eq!(field, "contacts[0].name", "{name}");
+        assert!(
+            message.contains("cannot hold a comma") && !message.contains('\n'),
+            "{message}"
+        );
+    }
+    let text = replace_once(V1A, "name = \"plane\"", "name = \"plate 3 (upper)\"");
+    assert!(Case::from_toml_str(&text, Path::new(".")).is_ok());
+}
+
 #[test]
 fn friction_errors_name_the_key_written() {
     let text = replace_once(V1A, "friction = { mu = 0.3 }", "friction = { mu = -0.3 }");
@@ -514,6 +536,45 @@ fn a_study_value_that_makes_a_case_invalid_is_refused_before_any_run() {
     );
 }
 
+/// A value that makes a run unable to start is found by the check before any run, as a Δt
+/// above the stable limit is, not only by the run itself (found by the commands' fuzz test:
+/// an initial state whose energy overflows passed the check, the other runs ran and were
+/// written, and the sweep failed with exit code 1 as if a run had failed).
+#[test]
+fn a_study_value_that_makes_a_run_unable_to_start_is_refused_before_any_run() {
+    let (dir, path) = study_dir(
+        "study_start",
+        "base = \"v1a.toml\"\n\n[[parameters]]\nkey = \"initial.velocity\"\nvalues = [[0.3, 0.0, -0.9], [0.3, 1e300, -0.9]]\n",
+    );
+    let study = Study::from_file(&path).unwrap();
+    let err = study.check(0).unwrap_err();
+    let Error::StudyRun { index, source, .. } = &err else {
+        panic!("expected StudyRun, got {err:?}");
+    };
+    assert_eq!(*index, 1);
+    assert_eq!(source.field(), Some("initial"), "{err}");
+    let table = dir.0.join("study.csv");
+    assert!(study.execute(&table, 1, &|_, _| {}).is_err());
+    assert!(!table.exists(), "a run was made");
+    // a service life without a wearing contact
+    std::fs::write(
+        dir.0.join("v1a.toml"),
+        format!("{V1A}\n[life]\ntarget_years = 1.0\n"),
+    )
+    .unwrap();
+    std::fs::write(
+        &path,
+        "base = \"v1a.toml\"\n\n[[parameters]]\nkey = \"contacts.*.friction.mu\"\nvalues = [0.1]\n",
+    )
+    .unwrap();
+    let err = Study::from_file(&path).unwrap().check(0).unwrap_err();
+    let Error::StudyRun { source, .. } = &err else {
+        panic!("expected StudyRun, got {err:?}");
+    };
+    assert_eq!(source.field(), Some("life"), "{err}");
+    assert!(err.to_string().contains("no contact has a wear law"), "{err}");
+}
+
 #[test]
 fn study_syntax_errors_give_their_line_and_column() {
     let (_dir, path) = study_dir(
@@ -569,6 +630,46 @@ fn a_missing_file_is_named_once() {
     // another file in the message is still named
     let err = Error::invalid("structure", "x");
     assert_eq!(err.in_file(path), "no_such_case.toml: structure: x");
+}
+
+/// An empty file name is refused naming its key (found by the commands' fuzz test: a study's
+/// `base = ""` was read as the study's folder, or as no file, and refused with
+/// `study.toml: : No such file or directory (os error 2)`, naming neither the key nor a file);
+/// so are a load table's and a modal basis's.
+#[test]
+fn an_empty_file_name_is_refused_naming_its_key() {
+    let (dir, _) = study_dir("empty_base", "");
+    for base in ["", " "] {
+        let study = format!(
+            "base = \"{base}\"\n\n[[parameters]]\nkey = \"time.duration\"\nvalues = [1e-3]\n"
+        );
+        let err = Study::from_toml_str(&study, &dir.0, None).unwrap_err();
+        let Error::Invalid { field, message } = &err else {
+            panic!("expected Error::Invalid, got {err:?}");
+        };
+        assert_eq!(field, "base");
+        assert!(
+            message.contains("an empty file name") && message.contains("the study file"),
+            "{message}"
+        );
+    }
+    let text = replace_once(
+        V1A,
+        "[tangential]\n",
+        "[[loads]]\npoint = \"mass\"\nforce = [0.0, 1.0, 0.0]\nhistory = { type = \"table\", file = \"\" }\n\n[tangential]\n",
+    );
+    let (field, message) = invalid_in(&text, &dir.0);
+    assert_eq!(field, "loads[0].history.file");
+    assert!(message.contains("an empty file name"), "{message}");
+    let modal = include_str!("../../../examples/v1a_modal_inline.toml");
+    let text = replace_once(
+        modal,
+        "frequencies_hz = [0.0, 0.0, 0.0]   # natural frequencies, Hz (0: rigid-body mode)",
+        "file = \"\"",
+    );
+    let (field, message) = invalid_in(&text, &dir.0);
+    assert_eq!(field, "structure.file");
+    assert!(message.contains("an empty file name"), "{message}");
 }
 
 /// An initial velocity whose kinetic energy overflows (found by the fuzz test: 1e300 m/s ran

@@ -725,6 +725,24 @@ pub fn service_life(
     service_life_with(case, life, &mut LifeControl::default(), observer)
 }
 
+/// Whether contact `k` of `model` has a wear law.
+fn wears(model: &Model, k: usize) -> bool {
+    model.wear.get(k).is_some_and(|w| w.is_some())
+}
+
+/// What [`service_life_with`] checks before it computes anything: the `[life]` settings, and
+/// a contact with a wear law. A front end calls it before it writes anything.
+pub fn check_life(case: &Case, life: &LifeSettings) -> Result<()> {
+    life.validate("life")?;
+    if !(0..case.model.contacts.len()).any(|k| wears(&case.model, k)) {
+        return Err(Error::invalid(
+            "life",
+            "no contact has a wear law: give `wear = { tube = …, support = …, scar = … }` in the [[contacts]] that wear (docs/WEAR.md)",
+        ));
+    }
+    Ok(())
+}
+
 /// How a service life is driven from outside: where its checkpoint goes, a life to
 /// continue, and a stop signal.
 #[derive(Default)]
@@ -864,19 +882,13 @@ pub fn service_life_with(
     control: &mut LifeControl,
     mut observer: impl FnMut(&LifeStep),
 ) -> Result<LifeResults> {
-    life.validate("life")?;
+    check_life(case, life)?;
     let start = Instant::now();
     let model = &case.model;
     let mut tracks: Vec<Track> = (0..model.contacts.len())
-        .filter(|&k| model.wear.get(k).is_some_and(|w| w.is_some()))
+        .filter(|&k| wears(model, k))
         .map(|k| Track::new(model, k, life.angular_bins))
         .collect();
-    if tracks.is_empty() {
-        return Err(Error::invalid(
-            "life",
-            "no contact has a wear law: give `wear = { tube = …, support = …, scar = … }` in the [[contacts]] that wear (docs/WEAR.md)",
-        ));
-    }
     let wearing: Vec<usize> = tracks.iter().map(|c| c.k).collect();
     let stop_requested = || control.stop.is_some_and(|s| s.load(Ordering::Relaxed));
     let mut state = match control.resume.take() {

@@ -54,7 +54,7 @@ use super::percentiles::{PercentileReport, PercentileRequest, percentiles_of_tab
 use super::sampling::{Distribution, Stream};
 use crate::case::fingerprint::{FileHashes, Fingerprint, canonical, differences};
 use crate::case::key_path::{KeyPath, KeyPathError, Missing, Part};
-use crate::case::{Case, check_case_text, parse_error};
+use crate::case::{Case, check_case_text, named_file, parse_error};
 use crate::error::{Error, Result};
 use crate::files::Lock;
 use crate::integrator::simulation::{RunResults, RunSettings, Simulation, Termination};
@@ -304,7 +304,7 @@ impl Study {
                 ));
             }
             (None, Some(name)) => {
-                let base_path = dir.join(name);
+                let base_path = named_file(dir, name, "base", "the study file")?;
                 let base_text =
                     std::fs::read_to_string(&base_path).map_err(|e| Error::io(&base_path, e))?;
                 // the base case's own mistakes are reported with their line in it
@@ -752,12 +752,14 @@ impl Study {
         }
     }
 
-    /// Builds the case of every run and checks it as a run would (the stability limit of
-    /// Δt included), `jobs` at a time (0: one per core), so that a value that makes a case
-    /// invalid is found before any run starts. The error is that of the first such run, as
-    /// [`Error::StudyRun`] naming it and its values. Returns the cases' warnings (an
-    /// implausible value, an impact resolved by too few steps…), each once with the number of
-    /// runs that give it, in the order of the runs.
+    /// Builds the case of every run and checks it as a run does as it starts (the stability
+    /// limit of Δt, the energy of the initial state, the memory of the fluid-elastic delays:
+    /// the simulation is set up, then dropped; a service life's settings and wearing
+    /// contacts), `jobs` at a time (0: one per core), so that a
+    /// value that makes a case invalid is found before any run starts. The error is that of
+    /// the first such run, as [`Error::StudyRun`] naming it and its values. Returns the cases'
+    /// warnings (an implausible value, an impact resolved by too few steps…), each once with
+    /// the number of runs that give it, in the order of the runs.
     pub fn check(&self, jobs: usize) -> Result<Vec<(String, usize)>> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(jobs)
@@ -770,7 +772,13 @@ impl Study {
                 .map(|run| {
                     self.case(run)
                         .and_then(|case| {
-                            Simulation::check(&case.model, &case.settings)?;
+                            // what a run checks as it starts, not the time step only: its
+                            // initial state's energy, the memory of its fluid-elastic delays
+                            drop(Simulation::with_recorder(&case.model, &case.settings, 1)?);
+                            // and a service life, what it checks before its first window
+                            if let Some(life) = &case.life {
+                                super::life::check_life(&case, life)?;
+                            }
                             Ok(case.warnings)
                         })
                         .map_err(|e| Error::StudyRun {

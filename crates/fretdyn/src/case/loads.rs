@@ -215,7 +215,10 @@ impl HistoryInput {
             HistoryInput::Table { table, file } => {
                 let rows = match (table, file) {
                     (Some(t), None) => t.clone(),
-                    (None, Some(f)) => read_table(&base.join(f), &format!("{field}.history.file"))?,
+                    (None, Some(f)) => {
+                        let key = format!("{field}.history.file");
+                        read_table(&super::named_file(base, f, &key, "the case file")?, &key)?
+                    }
                     _ => {
                         return Err(Error::invalid(
                             format!("{field}.history"),

@@ -184,6 +184,25 @@ pub fn absolute_file_names(case: &mut serde_json::Value, base: &Path) {
     histories(case, base);
 }
 
+/// The file a key names, `name` relative to `base`; an empty name is refused naming the key
+/// `field` (it was read as the folder `base` itself, or as no file at all, with an error that
+/// named neither the key nor a file: `: No such file or directory`). `relative_to` says what
+/// the name is relative to (`the case file`, `the study file`).
+pub(crate) fn named_file(
+    base: &Path,
+    name: &str,
+    field: &str,
+    relative_to: &str,
+) -> Result<std::path::PathBuf> {
+    if name.trim().is_empty() {
+        return Err(Error::invalid(
+            field,
+            format!("an empty file name: give the name of the file, relative to {relative_to}"),
+        ));
+    }
+    Ok(base.join(name))
+}
+
 /// Checks that `text` reads as a case file (TOML syntax, known keys, types), without building
 /// the case; errors give their line and column.
 pub(crate) fn check_case_text(text: &str) -> Result<()> {

@@ -463,7 +463,7 @@ impl StructureSection {
             } => {
                 let mut basis = match (file, frequencies_hz) {
                     (Some(f), None) => {
-                        let path = base.join(f);
+                        let path = super::named_file(base, f, "structure.file", "the case file")?;
                         let file = crate::structure::basis_file::read_basis_npz(&path)?;
                         warnings.extend(file.warnings);
                         abscissae.s = file.abscissae;
