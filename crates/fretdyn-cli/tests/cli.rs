@@ -1117,7 +1117,11 @@ wear = { tube = { law = \"archard\", coefficient = 2e-15 }, support = { law = \"
         let error = stderr.trim_end().lines().last().unwrap_or_default();
         assert!(error.starts_with("error: "), "{stderr}");
         assert!(
-            stderr.lines().rev().skip(1).all(|l| l.starts_with("warning: ")),
+            stderr
+                .lines()
+                .rev()
+                .skip(1)
+                .all(|l| l.starts_with("warning: ")),
             "{stderr}"
         );
         for n in &needles {

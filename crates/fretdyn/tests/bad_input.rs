@@ -572,7 +572,10 @@ fn a_study_value_that_makes_a_run_unable_to_start_is_refused_before_any_run() {
         panic!("expected StudyRun, got {err:?}");
     };
     assert_eq!(source.field(), Some("life"), "{err}");
-    assert!(err.to_string().contains("no contact has a wear law"), "{err}");
+    assert!(
+        err.to_string().contains("no contact has a wear law"),
+        "{err}"
+    );
 }
 
 #[test]
