@@ -274,10 +274,10 @@ fn cap_life(doc: &mut Value, cap: i64, bounded: &mut Vec<String>) {
 /// Multiplies the times of the run ([`TIME_KEYS`]) of a case as TOML by `f`.
 fn scale_times(doc: &mut Value, f: f64) {
     for key in TIME_KEYS {
-        if let Some(v) = at_mut(doc, key) {
-            if let Some(x) = number(Some(v)) {
-                *v = Value::Float(x * f);
-            }
+        if let Some(v) = at_mut(doc, key)
+            && let Some(x) = number(Some(v))
+        {
+            *v = Value::Float(x * f);
         }
     }
 }
@@ -333,22 +333,23 @@ fn select(a: &[Value], indices: &[usize]) -> Vec<Value> {
 /// study refuses (a count out of range, lists of unequal lengths) is kept.
 fn cap_study(study: &mut Value, original: &Value, bounded: &mut Vec<String>) {
     let Value::Table(t) = study else { return };
-    if let Some(Value::Integer(n)) = t.get("samples") {
-        if *n > SAMPLES && *n <= fretdyn::apps::study::MAX_SAMPLES {
-            bounded.push(format!("samples {n} → {SAMPLES}"));
-            t.insert("samples".into(), Value::Integer(SAMPLES));
-        }
+    if let Some(Value::Integer(n)) = t.get("samples")
+        && *n > SAMPLES
+        && *n <= fretdyn::apps::study::MAX_SAMPLES
+    {
+        bounded.push(format!("samples {n} → {SAMPLES}"));
+        t.insert("samples".into(), Value::Integer(SAMPLES));
     }
     let old_seeds: Vec<Value> = match original.get("seeds") {
         Some(Value::Array(a)) => a.clone(),
         _ => Vec::new(),
     };
-    if let Some(Value::Array(seeds)) = t.get_mut("seeds") {
-        if seeds.len() > SEEDS {
-            let chosen = keep(seeds.len(), |i| !old_seeds.contains(&seeds[i]), SEEDS);
-            bounded.push(format!("seeds: {} of {}", chosen.len(), seeds.len()));
-            *seeds = select(seeds, &chosen);
-        }
+    if let Some(Value::Array(seeds)) = t.get_mut("seeds")
+        && seeds.len() > SEEDS
+    {
+        let chosen = keep(seeds.len(), |i| !old_seeds.contains(&seeds[i]), SEEDS);
+        bounded.push(format!("seeds: {} of {}", chosen.len(), seeds.len()));
+        *seeds = select(seeds, &chosen);
     }
     let old_values: Vec<Value> = match original.get("parameters") {
         Some(Value::Array(ps)) => ps
@@ -527,12 +528,12 @@ fn plan(seed: u64, examples: &Examples) -> Option<Job> {
             windows *= 2.0;
         }
     }
-    if let Some(steps) = steps_of(&doc) {
-        if steps * windows > CASE_STEPS {
-            let f = CASE_STEPS / (steps * windows);
-            scale_times(&mut doc, f);
-            bounded.push(format!("times × {f:.3e}"));
-        }
+    if let Some(steps) = steps_of(&doc)
+        && steps * windows > CASE_STEPS
+    {
+        let f = CASE_STEPS / (steps * windows);
+        scale_times(&mut doc, f);
+        bounded.push(format!("times × {f:.3e}"));
     }
     Some(Job {
         seed,
@@ -1088,6 +1089,9 @@ struct Busy {
     since: Instant,
 }
 
+/// The report of every command, with the description of its failure if it failed.
+type Reports = Vec<(Report, Option<String>)>;
+
 #[test]
 fn mutated_inputs_to_the_commands_end_cleanly() {
     let count: usize = env_or("FRETDYN_FUZZ_COMMANDS", 800);
@@ -1101,7 +1105,7 @@ fn mutated_inputs_to_the_commands_end_cleanly() {
     let start = Instant::now();
     let next = Arc::new(AtomicUsize::new(0));
     let stop = Arc::new(AtomicBool::new(false));
-    let reports: Arc<Mutex<Vec<(Report, Option<String>)>>> = Arc::default();
+    let reports: Arc<Mutex<Reports>> = Arc::default();
     let busy: Arc<Mutex<Vec<Option<Busy>>>> = Arc::new(Mutex::new(vec![None; WORKERS]));
     let workers: Vec<_> = (0..WORKERS)
         .map(|w| {
@@ -1129,16 +1133,14 @@ fn mutated_inputs_to_the_commands_end_cleanly() {
                     });
                     let dir = scratch.0.join(format!("seed-{seed}"));
                     let (job, report) = one(seed, &examples, &dir, timeout);
-                    if verbose {
-                        if let Some(job) = &job {
-                            eprintln!(
-                                "{} → {:?} {:?} {}",
-                                job.label(),
-                                report.end,
-                                job.verdict,
-                                report.error
-                            );
-                        }
+                    if verbose && let Some(job) = &job {
+                        eprintln!(
+                            "{} → {:?} {:?} {}",
+                            job.label(),
+                            report.end,
+                            job.verdict,
+                            report.error
+                        );
                     }
                     let failure = report
                         .failure

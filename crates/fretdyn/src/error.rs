@@ -34,7 +34,7 @@ pub enum Error {
         "time.dt = {} s is above the stable limit {} s of central differences \
          (highest modal frequency plus contact penalty stiffnesses and fluid-elastic forces, docs/THEORY.md §2, §13): set time.dt ≤ {}",
         exponent(.dt),
-        exponent(.limit),
+        three_digits(.limit),
         exponent(.suggest)
     )]
     UnstableTimeStep { dt: f64, limit: f64, suggest: f64 },
@@ -151,6 +151,12 @@ fn exponent(x: &f64) -> String {
     format!("{:e}", rounded(*x))
 }
 
+/// A computed figure to three significant digits, in exponent notation (`2.04e-10`, `2e-3`):
+/// its fifteen digits (`2.04313638318077e-10`) say nothing more to a reader.
+fn three_digits(x: &f64) -> String {
+    format!("{:e}", format!("{x:.2e}").parse::<f64>().unwrap_or(*x))
+}
+
 #[cfg(test)]
 mod tests {
     use super::number;
@@ -180,7 +186,13 @@ mod tests {
         ] {
             assert_eq!(number(x), text, "{x:e}");
         }
-        // a computed limit, in exponent notation
+        // a computed limit, in exponent notation, to three significant digits
+        let e = super::Error::UnstableTimeStep {
+            dt: 1e-5,
+            limit: 2.04313638318077e-10,
+            suggest: 1.83e-10,
+        };
+        assert!(e.to_string().contains("the stable limit 2.04e-10 s"), "{e}");
         let e = super::Error::UnstableTimeStep {
             dt: 3e-3,
             limit: 2.0 / 1000.0 * (1.0 - 1e-16),

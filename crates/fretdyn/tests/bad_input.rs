@@ -126,24 +126,57 @@ fn two_contacts_with_the_same_name_are_refused() {
 
 /// A contact name heads columns of `study.csv` and `life.csv` (`<name>.wear_work_rate`): a
 /// comma in it (found by the commands' fuzz test: a name taken from a title) gave a header of
-/// more columns than the rows, and the sweep refused its own first row (exit code 1). A comma,
-/// a double quote or a line break is refused, naming the key; other characters are not.
+/// more columns than the rows, and the sweep refused its own first row (exit code 1). A study
+/// and a service life refuse a comma, a double quote or a line break, naming the key; a run
+/// accepts them (its `contacts.csv` quotes the name: tests/contacts_csv.rs), and other
+/// characters are accepted everywhere.
 #[test]
-fn a_contact_name_that_would_cut_the_output_tables_is_refused() {
+fn a_contact_name_that_would_cut_the_study_and_life_tables_is_refused() {
     for name in ["plate, upper", "plate \\\"3\\\"", "plate\\n3"] {
-        let (field, message) = invalid(&replace_once(
-            V1A,
-            "name = \"plane\"",
-            &format!("name = \"{name}\""),
-        ));
-        assert_eq!(field, "contacts[0].name", "{name}");
+        let text = replace_once(V1A, "name = \"plane\"", &format!("name = \"{name}\""));
+        // a run takes it
+        let case = Case::from_toml_str(&text, Path::new(".")).unwrap();
+        // a service life does not
+        let life = Case::from_toml_str(
+            &format!("{text}\n[life]\ntarget_years = 10.0\n"),
+            Path::new("."),
+        )
+        .unwrap();
+        let err = fretdyn::apps::life::check_life(&life, life.life.as_ref().unwrap()).unwrap_err();
+        assert_eq!(err.field(), Some("contacts[0].name"), "{name}: {err}");
         assert!(
-            message.contains("cannot hold a comma") && !message.contains('\n'),
-            "{message}"
+            err.to_string().contains("cannot hold a comma") && !err.to_string().contains('\n'),
+            "{err}"
         );
+        // nor a study
+        let dir = TempDir::new("study_name");
+        std::fs::write(dir.0.join("v1a.toml"), &text).unwrap();
+        let path = dir.0.join("study.toml");
+        std::fs::write(
+            &path,
+            "base = \"v1a.toml\"\n\n[[parameters]]\nkey = \"contacts.*.friction.mu\"\nvalues = [0.1, 0.3]\n",
+        )
+        .unwrap();
+        let err = Study::from_file(&path).unwrap().check(0).unwrap_err();
+        assert!(
+            err.to_string().contains("contacts[0].name")
+                && err.to_string().contains("cannot hold a comma"),
+            "{err}"
+        );
+        drop(case);
     }
     let text = replace_once(V1A, "name = \"plane\"", "name = \"plate 3 (upper)\"");
-    assert!(Case::from_toml_str(&text, Path::new(".")).is_ok());
+    let life = Case::from_toml_str(
+        &format!("{text}\n[life]\ntarget_years = 10.0\n"),
+        Path::new("."),
+    )
+    .unwrap();
+    let err = fretdyn::apps::life::check_life(&life, life.life.as_ref().unwrap()).unwrap_err();
+    // refused for another reason: no contact of V1a wears
+    assert!(
+        err.to_string().contains("no contact has a wear law"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -734,6 +734,7 @@ fn wears(model: &Model, k: usize) -> bool {
 /// a contact with a wear law. A front end calls it before it writes anything.
 pub fn check_life(case: &Case, life: &LifeSettings) -> Result<()> {
     life.validate("life")?;
+    super::check_names_for_tables(&case.model, "a service life")?;
     if !(0..case.model.contacts.len()).any(|k| wears(&case.model, k)) {
         return Err(Error::invalid(
             "life",

@@ -775,6 +775,7 @@ impl Study {
                             // what a run checks as it starts, not the time step only: its
                             // initial state's energy, the memory of its fluid-elastic delays
                             drop(Simulation::with_recorder(&case.model, &case.settings, 1)?);
+                            super::check_names_for_tables(&case.model, "a study")?;
                             // and a service life, what it checks before its first window
                             if let Some(life) = &case.life {
                                 super::life::check_life(&case, life)?;

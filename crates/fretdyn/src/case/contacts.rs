@@ -226,16 +226,6 @@ impl CaseFile {
                 (e, _) => e,
             })?;
             let name = c.name.clone().unwrap_or_else(|| format!("contact{k}"));
-            // the name heads columns of study.csv and life.csv (`<name>.wear_work_rate`) and
-            // fills cells of scars.csv: a comma, a quote or a line break would cut them
-            if name.contains([',', '"', '\n', '\r']) {
-                return Err(Error::invalid(
-                    format!("{field}.name"),
-                    format!(
-                        "{name:?}: a contact name cannot hold a comma, a double quote or a line break (it heads the columns of the output tables)"
-                    ),
-                ));
-            }
             if let Some(j) = names.insert(name.clone(), k) {
                 return Err(Error::invalid(
                     format!("{field}.name"),
