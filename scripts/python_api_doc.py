@@ -26,8 +26,9 @@ edit the docstrings (crates/fretdyn-python/python/fretdyn/), then run
 `python scripts/python_api_doc.py`. A test checks that this page is up to date. -->
 
 Install: `pip install ./crates/fretdyn-python` (or the wheel `.ci/run` builds); the optional
-dependencies are `pandas` (tables as DataFrames), `xarray` (`Result.to_xarray`) and
-`matplotlib` (`fretdyn.plot`): `pip install "fretdyn[all]"`.
+dependencies are `pandas` (tables as DataFrames), `xarray` with `netCDF4`
+(`Result.to_xarray`, `xarray.open_dataset("results.nc")`) and `matplotlib` (`fretdyn.plot`):
+`pip install "fretdyn[all]"` (which adds Dask and medcoupling too).
 """
 
 SECTION = re.compile(r"^(Parameters|Returns|Raises|Examples|Yields|See Also|Notes)$")

@@ -4,6 +4,7 @@
 //! step), `life.json` (the whole result), `scars.csv` (final scar profiles) and `life.png`.
 //! The library computes ([`fretdyn::apps::life::service_life`]); this prints and writes.
 
+use crate::run::significant;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -120,16 +121,35 @@ pub fn main(o: &Options) -> Result<(), Failure> {
         resume,
         stop: Some(&crate::signals::INTERRUPTED),
     };
-    let mut printed = Ok(());
+    // the wearing contacts, in the order of the life's rows: a column each, headed by its name
+    let names: Vec<&str> = (case.model.contacts.iter().zip(&case.model.wear))
+        .filter(|(_, w)| w.is_some())
+        .map(|(c, _)| c.name.as_str())
+        .collect();
+    let width = names
+        .iter()
+        .map(|n| n.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(9);
+    let mut printed = outln!(
+        "  {:>10}  tube depth (µm): {}",
+        "years",
+        names
+            .iter()
+            .map(|n| format!("{n:>width$}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
     let results = service_life_with(&case, &life, &mut control, |step: &LifeStep| {
         if printed.is_ok() && step.time > 0.0 {
             let depths: Vec<String> = step
                 .contacts
                 .iter()
-                .map(|c| format!("{:.3e}", c.tube_depth))
+                .map(|c| format!("{:>width$}", significant(c.tube_depth * 1e6, 4)))
                 .collect();
             printed = outln!(
-                "  {:>10.4} years  tube depth (m) {}",
+                "  {:>10.4}                   {}",
                 step.time / YEAR,
                 depths.join(" ")
             );
@@ -167,11 +187,12 @@ pub fn main(o: &Options) -> Result<(), Failure> {
                 |t| format!("{:.3} years", t / YEAR),
             )
         };
+        let um = |depth: f64| significant(depth * 1e6, 4);
         outln!(
-            "{name}: tube depth {:.4e} m (fixed gap {:.4e} m), support {:.4e} m; criterion {} (fixed gap {})",
-            last.tube_depth,
-            last.tube_depth_fixed_gap,
-            last.support_depth,
+            "{name}: tube depth {} µm (fixed gap {} µm), support {} µm; criterion {} (fixed gap {})",
+            um(last.tube_depth),
+            um(last.tube_depth_fixed_gap),
+            um(last.support_depth),
             reach(results.time_to_criterion[k]),
             reach(results.time_to_criterion_fixed_gap[k])
         )?;

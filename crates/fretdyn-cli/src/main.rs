@@ -74,7 +74,7 @@ enum Command {
         #[arg(short, long, value_parser = path)]
         output: Option<PathBuf>,
         /// Runs at a time [default: one per core].
-        #[arg(short, long, default_value_t = 0)]
+        #[arg(short, long, default_value_t = 0, hide_default_value = true)]
         jobs: usize,
         /// Start afresh: replace the table (and the percentiles and plots) of an earlier
         /// study in the folder instead of continuing it.

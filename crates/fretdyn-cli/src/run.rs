@@ -552,17 +552,17 @@ fn report(case: &Case, r: &RunResults, dir: &Path) -> Result<(), Failure> {
     )?;
     for c in &r.contacts {
         outln!(
-            "  {:<16} {:>8} {:>8.4} {:>8.4} {:>8.4} {:>12.5e} {:>14.5e} ± {}",
+            "  {:<16} {:>8} {:>8.4} {:>8.4} {:>8.4} {:>12} {:>14} ± {}",
             c.name,
             c.impacts,
             c.contact_time_fraction,
             c.stick_time_fraction,
             c.slip_time_fraction,
-            c.normal_force_max,
-            c.wear_work_rate,
+            significant(c.normal_force_max, 4),
+            significant(c.wear_work_rate, 4),
             c.errors
                 .wear_work_rate_se
-                .map_or("-".to_string(), |e| format!("{e:.2e}"))
+                .map_or("-".to_string(), |e| significant(e, 3))
         )?;
     }
     if let Some(c) = r.contacts.first() {
@@ -663,9 +663,46 @@ fn demo(options: &Options) -> Result<(), Failure> {
     Ok(())
 }
 
+/// `x` to `digits` significant digits as a person reads a figure: plain from 0.001 to a
+/// million (`939.7`, `14.62`, `0.004521`), in exponent notation outside (`1.462e-5`).
+pub(crate) fn significant(x: f64, digits: usize) -> String {
+    let digits = digits.max(1);
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    // the exponent of x once rounded (999.96 to 4 digits is 1000, exponent 3)
+    let e = format!("{x:.*e}", digits - 1)
+        .split_once('e')
+        .and_then(|(_, e)| e.parse::<i32>().ok())
+        .unwrap_or(0);
+    if (-3..6).contains(&e) {
+        let decimals = (digits as i32 - 1 - e).max(0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.*e}", digits - 1)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn figures_read_as_a_person_writes_them() {
+        for (x, digits, text) in [
+            (939.693, 4, "939.7"),
+            (14.6222, 4, "14.62"),
+            (4.4512, 3, "4.45"),
+            (0.0045213, 4, "0.004521"),
+            (1.46222e-5, 4, "1.462e-5"),
+            (2.5e7, 4, "2.500e7"),
+            (999.96, 4, "1000"),
+            (-0.5, 3, "-0.500"),
+            (0.0, 4, "0"),
+        ] {
+            assert_eq!(significant(x, digits), text, "{x}");
+        }
+    }
 
     /// The time histories need `remaining` bytes, their packing twice the run's total: a
     /// resumed run (some already written) asks less than a fresh one of the same case.

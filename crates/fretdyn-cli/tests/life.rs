@@ -58,7 +58,37 @@ fn a_life_writes_its_depths_against_time_and_converges_under_halvings() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(stdout.contains("bar: tube depth"), "{stdout}");
+    // the depths in µm under their contact's name; the last row's is the final depth printed
+    // after the life, read back from life.csv's last row
+    let header = stdout
+        .lines()
+        .find(|l| l.contains("tube depth (µm):"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert_eq!(header.split_whitespace().last(), Some("bar"), "{header}");
     let csv = std::fs::read_to_string(s.0.join("out/life.csv")).unwrap();
+    let last_csv: Vec<&str> = csv.lines().last().unwrap().split(',').collect();
+    let depth_column = csv
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|c| c == "bar.tube_depth")
+        .unwrap();
+    let depth_um = last_csv[depth_column].parse::<f64>().unwrap() * 1e6;
+    let final_line = stdout
+        .lines()
+        .find(|l| l.starts_with("bar: tube depth "))
+        .unwrap();
+    let printed: f64 = final_line["bar: tube depth ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        (printed / depth_um - 1.0).abs() < 1e-3 && final_line.contains(" µm (fixed gap "),
+        "{final_line} against {depth_um} µm"
+    );
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(header[0], "time_years");

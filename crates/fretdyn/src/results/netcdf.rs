@@ -173,6 +173,38 @@ fn probe_space(dir: &Path) -> std::io::Result<()> {
     written
 }
 
+/// Turns off HDF5's automatic printing of its error stack (`HDF5-DIAG: Error detected in
+/// HDF5 …`) in the calling thread, for a program that reads `results.nc` with the `netcdf`
+/// crate. libnetcdf 4.9 probes attributes that a file may not have (the quantization
+/// attributes, on every variable it opens): HDF5 reports each miss as an error on standard
+/// error, some twenty lines each, although nothing is wrong. libnetcdf turns the printing off
+/// in the thread that first opens a file; with a thread-safe HDF5 the setting is per thread,
+/// so a reader in another thread (a test of a multi-threaded harness) prints them all. The
+/// function `H5Eset_auto2` is looked up in the HDF5 library libnetcdf loaded, so nothing more
+/// is linked; without it (a libnetcdf built without HDF5) nothing is done.
+pub fn quiet_hdf5_errors() {
+    use std::ffi::{c_char, c_int, c_void};
+    unsafe extern "C" {
+        fn dlsym(handle: *mut c_void, symbol: *const c_char) -> *mut c_void;
+    }
+    /// `herr_t H5Eset_auto2(hid_t estack_id, H5E_auto2_t func, void *client_data)`.
+    type SetAuto = unsafe extern "C" fn(i64, *const c_void, *mut c_void) -> c_int;
+    /// glibc's `RTLD_DEFAULT`: the global symbols of the program and its libraries.
+    const RTLD_DEFAULT: *mut c_void = std::ptr::null_mut();
+    /// HDF5's `H5E_DEFAULT`: the current thread's error stack.
+    const H5E_DEFAULT: i64 = 0;
+    // SAFETY: dlsym with a NUL-terminated name; the symbol, when found, is HDF5's
+    // H5Eset_auto2 (hid_t is a 64-bit integer since HDF5 1.10), and a null function and
+    // client data turn the printing off.
+    unsafe {
+        let f = dlsym(RTLD_DEFAULT, c"H5Eset_auto2".as_ptr());
+        if !f.is_null() {
+            let set_auto: SetAuto = std::mem::transmute::<*mut c_void, SetAuto>(f);
+            set_auto(H5E_DEFAULT, std::ptr::null(), std::ptr::null_mut());
+        }
+    }
+}
+
 fn write_to(
     path: &Path,
     series: &[SeriesFile],
@@ -423,6 +455,7 @@ mod tests {
                 &mut ProgressOnly(|_| ControlFlow::Continue(())),
             )
             .unwrap();
+            super::quiet_hdf5_errors();
             let file = ::netcdf::open(dir.join(super::NETCDF_FILE)).unwrap();
             let text = |var: &str, attr: &str| -> String {
                 let v = file.variable(var).unwrap();
