@@ -17,7 +17,7 @@ mod dict_case;
 use dict_case::Document;
 
 pyo3::create_exception!(
-    _native,
+    fretdyn,
     FretdynError,
     pyo3::exceptions::PyValueError,
     "Bad input or a failed run; the message names the file, the field and the fix, as the CLI's."

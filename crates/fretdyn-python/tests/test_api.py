@@ -7,6 +7,7 @@ import importlib.util
 import json
 import os
 import re
+import pickle
 import subprocess
 import sys
 import time
@@ -676,3 +677,18 @@ def test_the_api_page_is_generated_from_the_docstrings():
 def test_everything_public_has_a_numpy_style_docstring():
     doc = api_doc()
     assert doc.undocumented() == []
+
+
+# --- the namespace ----------------------------------------------------------------------------
+
+
+def test_the_namespace_is_the_api():
+    # dir() lists the API, not what the package imports for itself
+    names = dir(fretdyn)
+    for own in ["Any", "List", "np", "os", "csv", "json", "tempfile", "Path"]:
+        assert own not in names, own
+    assert set(fretdyn.__all__) <= set(names) and {"med", "plot"} <= set(names)
+    # the error is fretdyn's, and survives pickling (a Dask worker sends it back so)
+    assert fretdyn.FretdynError.__module__ == "fretdyn"
+    e = pickle.loads(pickle.dumps(fretdyn.FretdynError("time.dt: must be > 0")))
+    assert isinstance(e, fretdyn.FretdynError) and str(e) == "time.dt: must be > 0"

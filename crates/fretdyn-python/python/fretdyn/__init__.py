@@ -43,6 +43,12 @@ __all__ = [
 ]
 __version__ = _native.__version__
 
+
+def __dir__() -> List[str]:
+    """The package's API (``__all__`` and its modules ``med`` and ``plot``), not the names it
+    imports for itself (``np``, ``os``, ``Any``…)."""
+    return sorted(set(__all__) | {"med", "plot"})
+
 PathLike = Union[str, os.PathLike]
 
 
