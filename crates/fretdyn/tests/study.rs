@@ -277,6 +277,15 @@ fn a_table_is_written_by_one_study_and_holds_each_run_once() {
     drop(open);
     assert_eq!(study.execute(&table, 2, &|_, _| {}).unwrap(), 3);
     assert!(study.percentiles(&table).unwrap().is_some());
+    // complete, the table lists its runs in order (run 1 was appended first, the others as
+    // two threads finished them)
+    let order: Vec<String> = std::fs::read_to_string(&table)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().to_string())
+        .collect();
+    assert_eq!(order, ["0", "1", "2", "3"]);
     // a run twice
     let text = std::fs::read_to_string(&table).unwrap();
     std::fs::write(&table, format!("{text}{row}\n")).unwrap();

@@ -1307,6 +1307,44 @@ impl StudyTable {
             .and_then(|_| self.file.flush())
             .map_err(|e| Error::io(&self.path, e))?;
         self.done.insert(index);
+        if self.done.len() == self.expected.len() {
+            self.sort_rows()?;
+        }
+        Ok(())
+    }
+
+    /// Puts the rows in the order of the runs once every run has its row: they are appended
+    /// as the runs finish, in the order the threads (or Dask's workers) finish them, and a
+    /// table read by a person, or compared between two sweeps, should not depend on that.
+    /// Each row keeps its bytes; the file is replaced atomically (a crash leaves the table
+    /// in one order or the other, whole), and reopened for appending.
+    fn sort_rows(&mut self) -> Result<()> {
+        let text = std::fs::read_to_string(&self.path).map_err(|e| Error::io(&self.path, e))?;
+        let mut lines = text.lines();
+        let Some(header) = lines.next() else {
+            return Ok(());
+        };
+        let run = |line: &str| {
+            line.split(',')
+                .next()
+                .and_then(|c| c.parse::<usize>().ok())
+                .unwrap_or(usize::MAX)
+        };
+        let mut rows: Vec<&str> = lines.filter(|l| !l.is_empty()).collect();
+        if rows.is_sorted_by_key(|l| run(l)) {
+            return Ok(());
+        }
+        rows.sort_by_key(|l| run(l));
+        let mut sorted = String::with_capacity(text.len());
+        for line in std::iter::once(header).chain(rows) {
+            sorted.push_str(line);
+            sorted.push('\n');
+        }
+        crate::files::write_text_atomically(&self.path, &sorted)?;
+        self.file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&self.path)
+            .map_err(|e| Error::io(&self.path, e))?;
         Ok(())
     }
 }
