@@ -552,6 +552,10 @@ def test_a_study_as_a_dict_equals_the_study_file(tmp_path):
     assert isinstance(from_file, pd.DataFrame)
     assert len(from_file) == 4 and from_file.attrs["runs_done"] == 4
     assert list(from_file["run"]) == [0, 1, 2, 3]
+    # the indices are integers, the statistics floats; V1a draws nothing: no seed (NaN)
+    assert from_file["run"].dtype == np.int64
+    assert from_file["seed"].isna().all() and from_file["seed"].dtype == np.float64
+    assert from_file["plane.wear_work_rate"].dtype == np.float64
     assert list(from_file.columns) == (tmp_path / "file.csv").read_text().splitlines()[0].split(",")
     case = fretdyn.Case.from_file(tmp_path / "v1a.toml")
     bases = [

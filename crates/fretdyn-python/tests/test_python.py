@@ -429,6 +429,10 @@ def test_a_probabilistic_study_on_a_dask_cluster_equals_the_local_study(tmp_path
     t = fretdyn.read_table(tmp_path / "dask.csv")
     c = t["contacts.0.obstacle.clearance"]
     assert np.all((c >= 1e-5) & (c < 3e-5)) and len(set(c)) == 6
+    # the workers' rows, appended as they came back, are in run order once the table is
+    # complete; the indices are integers
+    assert t["run"].dtype == np.int64 and list(t["run"]) == list(range(6))
+    assert t["sample"].dtype == np.int64 and sorted(t["sample"]) == list(range(6))
     p_local = fretdyn.percentiles(path, tmp_path / "local.csv", output=tmp_path)
     p_dask = fretdyn.percentiles(path, tmp_path / "dask.csv")
     assert p_local == p_dask

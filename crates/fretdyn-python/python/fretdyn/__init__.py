@@ -1004,7 +1004,8 @@ def read_table(table: PathLike) -> dict:
     -------
     dict
         Column name → numpy array of floats (numbers; NaN where empty) or list of str (text),
-        complete rows only, in the order of the file.
+        complete rows only, in the order of the file. The indices ``run``, ``sample`` and
+        ``seed`` are arrays of int64 when every row has one.
 
     Examples
     --------
@@ -1021,7 +1022,14 @@ def read_table(table: PathLike) -> dict:
             out[name] = np.array([float(v) if v else np.nan for v in col])
         except ValueError:
             out[name] = col
+            continue
+        if name in _INDEX_COLUMNS and all(v.isdigit() for v in col):
+            out[name] = np.array([int(v) for v in col], dtype=np.int64)
     return out
+
+
+# the columns of a study's table that count runs, samples and seeds: integers
+_INDEX_COLUMNS = ("run", "sample", "seed")
 
 
 from . import plot  # noqa: E402  (matplotlib is imported when a plot is drawn)
