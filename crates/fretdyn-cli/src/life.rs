@@ -16,7 +16,7 @@ use fretdyn::error::number;
 
 use crate::Failure;
 use crate::out::{errln, outln};
-use crate::plot::{self, Series};
+use crate::plot::{self, Layout, Mark, Panel, Series, YScale};
 
 /// Most halvings of `--halvings` (each about doubles the life steps of the one before).
 pub const MAX_HALVINGS: u32 = 10;
@@ -164,7 +164,7 @@ pub fn main(o: &Options) -> Result<(), Failure> {
         e => Failure::input(e.in_file(&path)),
     })?;
     printed?;
-    write(&dir, &results, life.criterion).map_err(|e| {
+    write(&dir, &case.title, &results, life.criterion).map_err(|e| {
         if checkpoint.exists() {
             Failure::failed(format!(
                 "{}; the life is kept in its checkpoint: once there is room on the disk, write its results with: fretdyn life --resume {}",
@@ -176,8 +176,7 @@ pub fn main(o: &Options) -> Result<(), Failure> {
         }
     })?;
     if o.plots {
-        draw(&dir.join("life.png"), &case.title, &results, life.criterion)
-            .map_err(|e| Failure::failed(format!("{}: {e}", dir.join("life.png").display())))?;
+        draw_folder(&dir).map_err(Failure::failed)?;
     }
     for (k, name) in results.contacts.iter().enumerate() {
         let last = &results.steps[results.steps.len() - 1].contacts[k];
@@ -470,7 +469,7 @@ fn end_depths(r: &LifeResults) -> Vec<f64> {
 
 /// Writes `life.csv`, `scars.csv` and `life.json`, each to a temporary name then renamed
 /// (a full disk never leaves a truncated table under its final name).
-fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Failure> {
+fn write(dir: &Path, title: &str, r: &LifeResults, criterion: Option<f64>) -> Result<(), Failure> {
     let put = |name: &str, text: String| {
         fretdyn::files::write_text_atomically(&dir.join(name), &text)
             .map_err(|e| Failure::failed(e.to_string()))
@@ -527,6 +526,7 @@ fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Fail
     }
     put("scars.csv", scars)?;
     let json = serde_json::json!({
+        "title": title,
         "criterion_depth": criterion,
         "results": r,
     });
@@ -536,81 +536,201 @@ fn write(dir: &Path, r: &LifeResults, criterion: Option<f64>) -> Result<(), Fail
     )
 }
 
-/// Two panels, the tube depth of every contact against service time with the scars fed back
-/// and at fixed gap; the criterion drawn when the depths come near it (within 3×).
-fn draw(path: &Path, title: &str, r: &LifeResults, criterion: Option<f64>) -> Result<(), String> {
-    let years: Vec<f64> = r.steps.iter().map(|s| s.time / YEAR).collect();
-    let column = |k: usize, fixed: bool| -> Vec<f64> {
-        r.steps
+/// A life's table as `life.csv` gives it, per contact: the tube depth with the scars fed back
+/// and at fixed gap, the wear work rate of each window and its standard error.
+pub struct LifeTable {
+    pub years: Vec<f64>,
+    pub contacts: Vec<String>,
+    pub depth: Vec<Vec<f64>>,
+    pub fixed: Vec<Vec<f64>>,
+    pub rate: Vec<Vec<f64>>,
+    pub rate_se: Vec<Vec<f64>>,
+}
+
+impl LifeTable {
+    /// Reads `life.csv` (an empty standard error: 0).
+    pub fn read(path: &Path) -> Result<Self, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+        if header.first() != Some(&"time_years") {
+            return Err(format!(
+                "{}: not a life table of fretdyn life (no time_years column)",
+                path.display()
+            ));
+        }
+        let contacts: Vec<String> = header
             .iter()
-            .map(|s| {
-                let c = &s.contacts[k];
-                if fixed {
-                    c.tube_depth_fixed_gap
-                } else {
-                    c.tube_depth
-                }
-            })
-            .collect()
-    };
-    let coupled: Vec<Vec<f64>> = (0..r.contacts.len()).map(|k| column(k, false)).collect();
-    let fixed: Vec<Vec<f64>> = (0..r.contacts.len()).map(|k| column(k, true)).collect();
-    let deepest = coupled
+            .filter_map(|h| h.strip_suffix(".tube_depth").map(str::to_string))
+            .collect();
+        let rows: Vec<Vec<f64>> = lines
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| l.split(',').map(|c| c.parse().unwrap_or(0.0)).collect())
+            .collect();
+        let column = |name: &str| -> Result<Vec<f64>, String> {
+            let i = header
+                .iter()
+                .position(|h| *h == name)
+                .ok_or_else(|| format!("{}: no column {name}", path.display()))?;
+            Ok(rows
+                .iter()
+                .map(|r| r.get(i).copied().unwrap_or(0.0))
+                .collect())
+        };
+        let per = |col: &str| -> Result<Vec<Vec<f64>>, String> {
+            contacts
+                .iter()
+                .map(|c| column(&format!("{c}.{col}")))
+                .collect()
+        };
+        Ok(Self {
+            years: column("time_years")?,
+            depth: per("tube_depth")?,
+            fixed: per("tube_depth_fixed_gap")?,
+            rate: per("wear_work_rate")?,
+            rate_se: per("wear_work_rate_se")?,
+            contacts,
+        })
+    }
+
+    /// The standard error of each depth of contact `k`: the depth gained over each life step
+    /// is the window's wear work rate times the step, so its relative error is the rate's
+    /// (SE/rate of the window that opened the step); windows are independent runs, so the
+    /// errors of the steps add in quadrature. At fixed gap every step has the first window's
+    /// rate: its relative error throughout.
+    pub fn depth_se(&self, k: usize) -> (Vec<f64>, Vec<f64>) {
+        let relative = |i: usize| {
+            let (r, se) = (self.rate[k][i], self.rate_se[k][i]);
+            if r > 0.0 && se.is_finite() {
+                se / r
+            } else {
+                0.0
+            }
+        };
+        let mut coupled = vec![0.0; self.years.len()];
+        let mut sum = 0.0;
+        for i in 1..self.years.len() {
+            let gained = self.depth[k][i] - self.depth[k][i - 1];
+            sum += (gained * relative(i - 1)).powi(2);
+            coupled[i] = sum.sqrt();
+        }
+        // the first window's: the first row with a rate and its error
+        let first = (0..self.years.len())
+            .map(relative)
+            .find(|r| *r > 0.0)
+            .unwrap_or(0.0);
+        let fixed = self.fixed[k].iter().map(|d| d * first).collect();
+        (coupled, fixed)
+    }
+}
+
+/// `life.png` of the life in `dir`, from its `life.csv` and `life.json`: two panels (the
+/// tube depth of every contact against service time with the scars fed back, and at fixed
+/// gap) on the same y limits, each depth with a band of ± its standard error
+/// ([`LifeTable::depth_se`]) and the plugging criterion of `life.json` as a line.
+pub fn draw_folder(dir: &Path) -> Result<PathBuf, String> {
+    let table = LifeTable::read(&dir.join("life.csv"))?;
+    let json_path = dir.join("life.json");
+    let json: serde_json::Value = std::fs::read_to_string(&json_path)
+        .map_err(|e| e.to_string())
+        .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+        .map_err(|e| format!("{}: {e}", json_path.display()))?;
+    let criterion = json["criterion_depth"].as_f64();
+    let title = json["title"].as_str().map_or_else(
+        || {
+            dir.file_name()
+                .map_or("life".into(), |n| n.to_string_lossy().into_owned())
+        },
+        str::to_string,
+    );
+    let path = dir.join("life.png");
+    draw(&path, &title, &table, criterion)?;
+    Ok(path)
+}
+
+fn draw(path: &Path, title: &str, t: &LifeTable, criterion: Option<f64>) -> Result<(), String> {
+    let errors: Vec<(Vec<f64>, Vec<f64>)> = (0..t.contacts.len()).map(|k| t.depth_se(k)).collect();
+    // the criterion as a line when the depths come near it (within 3×, else it would flatten
+    // them), else in the title
+    let deepest = t
+        .depth
         .iter()
-        .chain(&fixed)
+        .chain(&t.fixed)
         .flatten()
         .copied()
         .fold(0.0, f64::max);
-    let level: Vec<f64> = match criterion {
-        Some(c) if deepest >= c / 3.0 => vec![c; years.len()],
-        _ => Vec::new(),
+    let (marks, beyond): (Vec<Mark>, String) = match criterion {
+        Some(c) if deepest >= c / 3.0 => (
+            vec![Mark::Level {
+                label: "plugging criterion".into(),
+                y: c,
+            }],
+            String::new(),
+        ),
+        Some(c) => {
+            let (unit, factor) = plot::unit_for("depth (m)", c);
+            (
+                Vec::new(),
+                format!(
+                    ", plugging criterion {} {unit}, far above",
+                    plot::significant(c / factor, 3)
+                ),
+            )
+        }
+        None => (Vec::new(), String::new()),
     };
     fn panel<'a>(
-        label: &str,
-        names: &[String],
-        years: &'a [f64],
+        caption: &str,
+        t: &'a LifeTable,
         columns: &'a [Vec<f64>],
-        level: &'a [f64],
-    ) -> (String, Vec<Series<'a>>) {
-        let mut series: Vec<Series> = names
-            .iter()
-            .zip(columns)
-            .map(|(name, y)| Series {
-                label: name.clone(),
-                x: years,
-                y,
-            })
-            .collect();
-        if !level.is_empty() {
-            series.push(Series {
-                label: "criterion".into(),
-                x: years,
-                y: level,
-            });
+        errors: Vec<Vec<f64>>,
+        marks: &[Mark],
+    ) -> Panel<'a> {
+        Panel {
+            title: caption.to_string(),
+            series: t
+                .contacts
+                .iter()
+                .zip(columns)
+                .map(|(name, y)| Series {
+                    label: name.clone(),
+                    x: &t.years,
+                    y,
+                })
+                .collect(),
+            errors,
+            marks: marks.to_vec(),
         }
-        (label.to_string(), series)
     }
+    let (coupled, fixed): (Vec<Vec<f64>>, Vec<Vec<f64>>) = errors.into_iter().unzip();
     let panels = vec![
         panel(
             "scars fed back into the obstacles",
-            &r.contacts,
-            &years,
-            &coupled,
-            &level,
+            t,
+            &t.depth,
+            coupled,
+            &marks,
         ),
         panel(
             "fixed gap (the first window's rates)",
-            &r.contacts,
-            &years,
-            &fixed,
-            &level,
+            t,
+            &t.fixed,
+            fixed,
+            &marks,
         ),
     ];
-    plot::panels_plot(
+    plot::stacked(
         path,
-        &format!("{title}: tube wear depth"),
+        &format!("{title}: tube wear depth (± standard error{beyond})"),
         "service time (years)",
         "depth (m)",
         &panels,
+        &Layout {
+            same_y_unit: true,
+            same_y_limits: true,
+            y_scale: YScale::Linear,
+            bands: true,
+            ..Layout::default()
+        },
     )
 }

@@ -84,12 +84,18 @@ enum Command {
         #[arg(short, long)]
         quiet: bool,
     },
-    /// Draw the plots of a run folder again (forces, displacements, orbits in the holes,
-    /// peak-force histograms, wear work rates).
+    /// Draw the figures of a folder fretdyn wrote again: a run's (forces, displacements,
+    /// orbits in the holes, peak-force histograms, wear work rates), a study's (study.png,
+    /// percentiles.png), a life's (life.png) or a modes folder's (mode_shapes.png); the kind
+    /// of folder is told by the files in it.
     Plot {
-        /// Folder written by `fretdyn run`.
+        /// Folder written by `fretdyn run`, `sweep`, `life` or `modes`.
         #[arg(value_parser = path)]
         dir: PathBuf,
+        /// The y axis of a study's study.png: log when the values span two decades or more
+        /// (auto), or always linear or log.
+        #[arg(long, value_enum, default_value_t = YAxis::Auto)]
+        y_scale: YAxis,
     },
     /// Run V1a, V1b, V1c (docs/THEORY.md §6) with every method, compare with the analytic solution,
     /// write the figures; exit code 1 if a check fails.
@@ -213,6 +219,24 @@ enum Command {
     },
 }
 
+/// The y axis of a study's figure (`fretdyn plot --y-scale`).
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum YAxis {
+    Auto,
+    Linear,
+    Log,
+}
+
+impl From<YAxis> for plot::YScale {
+    fn from(a: YAxis) -> Self {
+        match a {
+            YAxis::Auto => plot::YScale::Auto,
+            YAxis::Linear => plot::YScale::Linear,
+            YAxis::Log => plot::YScale::Log,
+        }
+    }
+}
+
 /// Exit code of input errors (bad case file, bad option).
 pub const EXIT_INPUT: u8 = 2;
 /// Exit code of a run that failed (diverged, verification check failed).
@@ -302,11 +326,12 @@ fn main() -> ExitCode {
             fresh,
             quiet,
         } => sweep::main(&study, output, jobs, fresh, quiet),
-        Command::Plot { dir } => results_plots::plot_run(&dir).and_then(|files| {
-            files
-                .iter()
-                .try_for_each(|f| outln!("wrote {}", f.display()))
-        }),
+        Command::Plot { dir, y_scale } => results_plots::plot_folder(&dir, y_scale.into())
+            .and_then(|files| {
+                files
+                    .iter()
+                    .try_for_each(|f| outln!("wrote {}", f.display()))
+            }),
         Command::Verify { output, quiet } => verify::main(&output, quiet),
         Command::Completions { shell } => {
             let mut script = Vec::new();

@@ -286,6 +286,117 @@ fn label_at(ticks: &[(f64, String)], v: f64) -> String {
 }
 
 // ---------------------------------------------------------------------------------------------
+// What a figure promises, recorded as it is drawn
+
+/// An axis as drawn: title, ticks (position in plot coordinates, label), range, and whether
+/// the coordinates are log10 of the values.
+#[derive(Debug, Default, Clone)]
+pub struct AxisRecord {
+    pub title: String,
+    pub ticks: Vec<(f64, String)>,
+    pub range: (f64, f64),
+    pub log: bool,
+}
+
+/// A panel as drawn: its caption (and its width in pixels, the panel's width), axes, legend
+/// entries, curves, reference lines, error bars and bars.
+#[derive(Debug, Default, Clone)]
+pub struct PanelRecord {
+    pub caption: String,
+    pub caption_width: u32,
+    pub width: u32,
+    pub x: AxisRecord,
+    pub y: AxisRecord,
+    /// Legend entries, each drawn beside a short line of its style.
+    pub keys: Vec<String>,
+    /// Curves: label, points, largest |y| (0: a line along the axis), points marked.
+    pub series: Vec<(String, usize, f64, bool)>,
+    /// Reference lines: label, position, vertical (at an x) or horizontal (at a y).
+    pub lines: Vec<(String, f64, bool)>,
+    /// Error bars: (at, from, to), vertical (x, y₀, y₁) or horizontal (y, x₀, x₁).
+    pub error_bars: Vec<(f64, f64, f64, bool)>,
+    /// Shaded bands: label and number of points.
+    pub bands: Vec<(String, usize)>,
+    /// Bars: label, value drawn, ± error drawn (0: no bar), x from and to.
+    pub bars: Vec<(String, f64, f64, f64, f64)>,
+}
+
+/// A figure as drawn: canvas size, title lines (text, width in pixels, font size), panels.
+#[derive(Debug, Default, Clone)]
+pub struct Figure {
+    pub size: (u32, u32),
+    pub title: Vec<(String, u32, u32)>,
+    pub panels: Vec<PanelRecord>,
+}
+
+impl Figure {
+    /// The figure as JSON (what the tests read back).
+    pub fn to_json(&self) -> serde_json::Value {
+        let axis = |a: &AxisRecord| {
+            serde_json::json!({
+                "title": a.title,
+                "ticks": a.ticks.iter().map(|(p, l)| serde_json::json!([p, l])).collect::<Vec<_>>(),
+                "range": [a.range.0, a.range.1],
+                "log": a.log,
+            })
+        };
+        serde_json::json!({
+            "size": [self.size.0, self.size.1],
+            "title": self.title.iter().map(|(t, w, f)| serde_json::json!({"text": t, "width": w, "font": f})).collect::<Vec<_>>(),
+            "panels": self.panels.iter().map(|p| serde_json::json!({
+                "caption": p.caption,
+                "caption_width": p.caption_width,
+                "width": p.width,
+                "x": axis(&p.x),
+                "y": axis(&p.y),
+                "keys": p.keys,
+                "series": p.series.iter().map(|(l, n, m, marked)| serde_json::json!({"label": l, "points": n, "max_abs_y": m, "marked": marked})).collect::<Vec<_>>(),
+                "lines": p.lines.iter().map(|(l, at, v)| serde_json::json!({"label": l, "at": at, "vertical": v})).collect::<Vec<_>>(),
+                "error_bars": p.error_bars.iter().map(|(at, a, b, v)| serde_json::json!({"at": at, "from": a, "to": b, "vertical": v})).collect::<Vec<_>>(),
+                "bands": p.bands.iter().map(|(l, n)| serde_json::json!({"label": l, "points": n})).collect::<Vec<_>>(),
+                "bars": p.bars.iter().map(|(l, v, e, x0, x1)| serde_json::json!({"label": l, "value": v, "error": e, "from": x0, "to": x1})).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+        })
+    }
+}
+
+/// Environment variable: when set, every PNG is written with `<file>.png.json` beside it, the
+/// [`Figure`] as drawn, for the tests to read back what a figure promises.
+pub const RECORD_VARIABLE: &str = "FRETDYN_FIGURE_RECORD";
+
+thread_local! {
+    static RECORD: std::cell::RefCell<Option<Figure>> = const { std::cell::RefCell::new(None) };
+}
+
+fn start_record(size: (u32, u32), title: Vec<(String, u32, u32)>) {
+    RECORD.with(|r| {
+        *r.borrow_mut() = Some(Figure {
+            size,
+            title,
+            panels: Vec::new(),
+        })
+    });
+}
+
+/// Adds to the record of the panel being drawn.
+fn record(f: impl FnOnce(&mut PanelRecord)) {
+    RECORD.with(|r| {
+        if let Some(p) = r
+            .borrow_mut()
+            .as_mut()
+            .and_then(|fig| fig.panels.last_mut())
+        {
+            f(p);
+        }
+    });
+}
+
+/// The record of the figure drawn last on this thread.
+pub fn take_record() -> Option<Figure> {
+    RECORD.with(|r| r.borrow_mut().take())
+}
+
+// ---------------------------------------------------------------------------------------------
 // Chart set-up, shared by every chart
 
 type Area<'p> = DrawingArea<BitMapBackend<'p>, Shift>;
@@ -373,17 +484,98 @@ const Y_LABEL_AREA: u32 = 80;
 const KEY_ROW: u32 = 18;
 
 /// A white canvas of `size` with the plot's title on top, and its panels: a grid of
-/// (rows, columns) below the title.
+/// (rows, columns) below the title. A title wider than the canvas is wrapped (and its font
+/// shrunk when a word would not fit), the canvas taller by the extra lines ([`titled_size`]).
 fn canvas<'p>(
     path: &'p Path,
     size: (u32, u32),
     title: &str,
     grid: (usize, usize),
 ) -> DrawResult<(Area<'p>, Vec<Area<'p>>)> {
-    canvas_on(BitMapBackend::new(path, size), title, grid)
+    canvas_on(
+        BitMapBackend::new(path, titled_size(size, title)),
+        title,
+        grid,
+    )
 }
 
-/// [`canvas`] on a backend (a file or a buffer of pixels).
+/// Font size of a figure's title.
+const TITLE_FONT: u32 = 22;
+/// Smallest font a title is shrunk to before it is wrapped on more than two lines.
+const TITLE_FONT_MIN: u32 = 14;
+
+/// The width in pixels of `text` in the embedded font at `size` px.
+pub fn text_width(text: &str, size: u32) -> u32 {
+    register_font();
+    ("sans-serif", size)
+        .into_font()
+        .box_size(text)
+        .map_or(0, |(w, _)| w)
+}
+
+/// The lines of a title on a canvas `width` wide, and their font size: one line when it fits;
+/// else wrapped at spaces (after an em dash or a colon where one is near), in at most two
+/// lines at [`TITLE_FONT`] or in a font shrunk down to [`TITLE_FONT_MIN`], else in as many
+/// lines as it takes.
+pub fn title_lines(title: &str, width: u32) -> (Vec<String>, u32) {
+    let room = width.saturating_sub(2 * MARGIN);
+    let wrap = |size: u32| -> Vec<String> {
+        let mut lines: Vec<String> = Vec::new();
+        let mut line = String::new();
+        for word in title.split(' ') {
+            let candidate = if line.is_empty() {
+                word.to_string()
+            } else {
+                format!("{line} {word}")
+            };
+            if !line.is_empty() && text_width(&candidate, size) > room {
+                lines.push(std::mem::take(&mut line));
+                line = word.to_string();
+            } else {
+                line = candidate;
+            }
+        }
+        lines.push(line);
+        lines
+    };
+    let fits = |lines: &[String], size: u32| lines.iter().all(|l| text_width(l, size) <= room);
+    if fits(&[title.to_string()], TITLE_FONT) {
+        return (vec![title.to_string()], TITLE_FONT);
+    }
+    // the case's title, then what the figure shows
+    if let Some((case, what)) = title.rsplit_once(" — ") {
+        let lines = [case.to_string(), format!("— {what}")];
+        if fits(&lines, TITLE_FONT) {
+            return (lines.to_vec(), TITLE_FONT);
+        }
+    }
+    let mut size = TITLE_FONT;
+    loop {
+        let lines = wrap(size);
+        if (lines.len() <= 2 && fits(&lines, size)) || size <= TITLE_FONT_MIN {
+            return (lines, size);
+        }
+        size -= 2;
+    }
+}
+
+/// Height of the title band of a canvas `width` wide.
+fn title_height(title: &str, width: u32) -> u32 {
+    let (lines, size) = title_lines(title, width);
+    10 + lines.len() as u32 * (size + 8)
+}
+
+/// The size of a canvas meant as `size` with a one-line title, grown by the extra lines of
+/// `title`.
+pub fn titled_size(size: (u32, u32), title: &str) -> (u32, u32) {
+    let one = 10 + TITLE_FONT + 8;
+    (
+        size.0,
+        size.1 + title_height(title, size.0).saturating_sub(one),
+    )
+}
+
+/// [`canvas`] on a backend (a file or a buffer of pixels) already of [`titled_size`].
 fn canvas_on<'p>(
     backend: BitMapBackend<'p>,
     title: &str,
@@ -392,8 +584,26 @@ fn canvas_on<'p>(
     register_font();
     let root = backend.into_drawing_area();
     root.fill(&WHITE)?;
-    let root = root.titled(title, ("sans-serif", 22))?;
-    let panels = root.split_evenly(grid);
+    let (width, height) = root.dim_in_pixel();
+    let (lines, size) = title_lines(title, width);
+    let style =
+        TextStyle::from(("sans-serif", size).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+    for (i, line) in lines.iter().enumerate() {
+        root.draw_text(
+            line,
+            &style,
+            (width as i32 / 2, 8 + i as i32 * (size as i32 + 8)),
+        )?;
+    }
+    start_record(
+        (width, height),
+        lines
+            .iter()
+            .map(|l| (l.clone(), text_width(l, size), size))
+            .collect(),
+    );
+    let (_, body) = root.split_vertically(title_height(title, width));
+    let panels = body.split_evenly(grid);
     Ok((root, panels))
 }
 
@@ -432,9 +642,14 @@ fn frame<'p>(
     let caption_height = if caption.is_empty() { 6 } else { 24 };
     let head = caption_height + KEY_ROW * rows.len() as u32;
     let (top, body) = area.split_vertically(head);
+    // a caption wider than the panel: a smaller font
+    let mut caption_font = 16;
+    while caption_font > 9 && text_width(caption, caption_font) > width.saturating_sub(2 * MARGIN) {
+        caption_font -= 1;
+    }
     if !caption.is_empty() {
-        let style =
-            TextStyle::from(("sans-serif", 16).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+        let style = TextStyle::from(("sans-serif", caption_font).into_font())
+            .pos(Pos::new(HPos::Center, VPos::Top));
         top.draw_text(caption, &style, (width as i32 / 2, 4))?;
     }
     for (r, row) in rows.iter().enumerate() {
@@ -457,6 +672,25 @@ fn frame<'p>(
     let plot_width = width.saturating_sub(Y_LABEL_AREA + 2 * MARGIN);
     let plot_height = height.saturating_sub(head + X_LABEL_AREA + 2 * MARGIN);
     let (xa, ya) = (x.ticks(plot_width, 75), y.ticks(plot_height, 32));
+    let axis_record = |spec: &AxisSpec, a: &Axis| AxisRecord {
+        title: a.title.clone(),
+        ticks: a.ticks.clone(),
+        range: (spec.range.start, spec.range.end),
+        log: matches!(spec.scale, Scale::Log10),
+    };
+    RECORD.with(|r| {
+        if let Some(fig) = r.borrow_mut().as_mut() {
+            fig.panels.push(PanelRecord {
+                caption: caption.to_string(),
+                caption_width: text_width(caption, caption_font),
+                width,
+                x: axis_record(&x, &xa),
+                y: axis_record(&y, &ya),
+                keys: keys.iter().map(|k| k.label.clone()).collect(),
+                ..PanelRecord::default()
+            });
+        }
+    });
     let coord = |range: &Range<f64>, a: &Axis| Ticked {
         inner: range.clone().into(),
         ticks: a.ticks.iter().map(|t| t.0).collect(),
@@ -481,9 +715,18 @@ fn frame<'p>(
     Ok(chart)
 }
 
-/// Writes the PNG; errors name the file.
+/// Writes the PNG (and, with [`RECORD_VARIABLE`] set, its record); errors name the file.
 fn finish(path: &Path, drawn: DrawResult<()>) -> Result<(), String> {
-    drawn.map_err(|e| format!("{}: cannot draw the plot: {e}", path.display()))
+    drawn.map_err(|e| format!("{}: cannot draw the plot: {e}", path.display()))?;
+    if let Some(figure) = take_record()
+        && std::env::var_os(RECORD_VARIABLE).is_some()
+    {
+        let mut name = path.as_os_str().to_owned();
+        name.push(".json");
+        std::fs::write(&name, format!("{:#}\n", figure.to_json()))
+            .map_err(|e| format!("{}: {e}", Path::new(&name).display()))?;
+    }
+    Ok(())
 }
 
 fn keys(series: &[Series], dashed_last: bool) -> Vec<Key> {
@@ -524,19 +767,25 @@ pub fn line_plot(
     series: &[Series],
     dashed_last: bool,
 ) -> Result<(), String> {
-    finish(
-        path,
-        panels(
-            path,
-            title,
-            x_label,
-            y_label,
-            &[(String::new(), series)],
-            dashed_last,
-            &[],
-            600,
-        ),
-    )
+    let panel = Panel {
+        title: String::new(),
+        series: series
+            .iter()
+            .map(|s| Series {
+                label: s.label.clone(),
+                x: s.x,
+                y: s.y,
+            })
+            .collect(),
+        errors: Vec::new(),
+        marks: Vec::new(),
+    };
+    let layout = Layout {
+        dashed_last,
+        height: Some(600),
+        ..Layout::default()
+    };
+    stacked(path, title, x_label, y_label, &[panel], &layout)
 }
 
 /// A vertical error bar at `x` from `lo` to `hi`, with caps of half-width `cap` (in x units).
@@ -559,17 +808,24 @@ pub fn panels_plot_with_errors(
     panels_in: &[(String, Vec<Series>)],
     errors: &[Vec<Vec<f64>>],
 ) -> Result<(), String> {
-    let borrowed: Vec<(String, &[Series])> = panels_in
+    let panels: Vec<Panel> = panels_in
         .iter()
-        .map(|(t, s)| (t.clone(), s.as_slice()))
+        .enumerate()
+        .map(|(p, (t, series))| Panel {
+            title: t.clone(),
+            series: series
+                .iter()
+                .map(|s| Series {
+                    label: s.label.clone(),
+                    x: s.x,
+                    y: s.y,
+                })
+                .collect(),
+            errors: errors.get(p).cloned().unwrap_or_default(),
+            marks: Vec::new(),
+        })
         .collect();
-    let height = 60 + 300 * borrowed.len().max(1) as u32;
-    finish(
-        path,
-        panels(
-            path, title, x_label, y_label, &borrowed, false, errors, height,
-        ),
-    )
+    stacked(path, title, x_label, y_label, &panels, &Layout::default())
 }
 
 /// Stacked panels, one per entry (panel title, series), sharing the x label; 300 px each.
@@ -583,50 +839,324 @@ pub fn panels_plot(
     panels_plot_with_errors(path, title, x_label, y_label, panels_in, &[])
 }
 
-/// Stacked panels; `errors[p][s][i]`, when given, is the ±error bar of point `i` of series `s`
-/// of panel `p` (the y range then holds the bars).
-#[allow(clippy::too_many_arguments)]
-fn panels(
+/// A reference drawn over a panel's curves, with its legend entry (one per label).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Mark {
+    /// A horizontal dashed line across the panel at `y` (a criterion).
+    Level { label: String, y: f64 },
+    /// A vertical dashed line across the panel at `x` (a support, the face of an obstacle).
+    At { label: String, x: f64 },
+    /// A percentile: a vertical segment at `x` from 0 up to `level`, and its interval
+    /// `[low, high]` at `level` as a horizontal error bar (a missing bound: to the panel's
+    /// edge, without a cap).
+    Percentile {
+        label: String,
+        x: f64,
+        level: f64,
+        low: Option<f64>,
+        high: Option<f64>,
+    },
+}
+
+impl Mark {
+    fn label(&self) -> &str {
+        match self {
+            Mark::Level { label, .. } | Mark::At { label, .. } | Mark::Percentile { label, .. } => {
+                label
+            }
+        }
+    }
+}
+
+/// One panel of [`stacked`]: its title, curves, the ± standard error of every point of each
+/// curve (`errors[s][i]`; empty: none) and reference marks.
+pub struct Panel<'a> {
+    pub title: String,
+    pub series: Vec<Series<'a>>,
+    pub errors: Vec<Vec<f64>>,
+    pub marks: Vec<Mark>,
+}
+
+/// How the y axes are scaled.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub enum YScale {
+    /// Linear, unless every value is positive and they span [`LOG_DECADES`] decades or more.
+    #[default]
+    Auto,
+    Linear,
+    Log,
+}
+
+/// Positive values spanning this many decades are drawn on a log axis by [`YScale::Auto`].
+pub const LOG_DECADES: f64 = 2.0;
+
+/// How the panels of [`stacked`] are drawn together.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Layout {
+    /// The last series of each panel is the reference, dashed in black.
+    pub dashed_last: bool,
+    /// One SI prefix on the y axes of every panel (panels that are compared).
+    pub same_y_unit: bool,
+    /// One y range for every panel.
+    pub same_y_limits: bool,
+    pub y_scale: YScale,
+    /// The x axes' prefix chosen for this magnitude (values in legends written alike).
+    pub x_magnitude: Option<f64>,
+    /// The errors drawn as a shaded band about each curve rather than bars.
+    pub bands: bool,
+    /// Height of the canvas (default: 60 px and 300 px a panel).
+    pub height: Option<u32>,
+}
+
+/// Whether `values`, none negative, have positive ones spanning at least [`LOG_DECADES`]
+/// decades (zeros are left out: a log axis does not draw them, and says so).
+pub fn spans_decades(values: impl IntoIterator<Item = f64>) -> bool {
+    let (mut lo, mut hi, mut any) = (f64::INFINITY, 0.0f64, false);
+    for v in values.into_iter().filter(|v| v.is_finite()) {
+        if v < 0.0 {
+            return false;
+        }
+        if v == 0.0 {
+            continue;
+        }
+        any = true;
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    any && (hi / lo).log10() >= LOG_DECADES
+}
+
+/// The SI prefix's factor that [`axis`] gives an axis `label` of values up to `magnitude`,
+/// and the prefixed unit (`("mW", 1e-3)`); a unit without prefixes: itself and 1.
+pub fn unit_for(label: &str, magnitude: f64) -> (String, f64) {
+    let (title, factor) = unit_scale(label, magnitude);
+    (split_label(&title).1.to_string(), factor)
+}
+
+/// `v` with `digits` significant digits, no exponent (`436`, `0.0123`).
+pub fn significant(v: f64, digits: usize) -> String {
+    if !(v.is_finite() && v != 0.0) {
+        return format!("{v}");
+    }
+    let decimals = (digits as i32 - 1 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.decimals$}")
+}
+
+/// Stacked panels sharing the x label, with error bars or bands, reference marks and the y
+/// axes as `layout` says; the PNG at `path`.
+pub fn stacked(
     path: &Path,
     title: &str,
     x_label: &str,
     y_label: &str,
-    panels: &[(String, &[Series])],
-    dashed_last: bool,
-    errors: &[Vec<Vec<f64>>],
-    height: u32,
+    panels: &[Panel],
+    layout: &Layout,
+) -> Result<(), String> {
+    let height = layout
+        .height
+        .unwrap_or_else(|| stacked_size(panels.len()).1);
+    finish(
+        path,
+        draw_stacked(
+            path,
+            (WIDTH, height),
+            title,
+            x_label,
+            y_label,
+            panels,
+            layout,
+        ),
+    )
+}
+
+/// The points of a panel's error bars: (series, x, y − e, y + e) for every point with an
+/// error.
+fn error_points(panel: &Panel) -> Vec<(usize, f64, f64, f64)> {
+    panel
+        .series
+        .iter()
+        .enumerate()
+        .flat_map(|(k, s)| {
+            let e = panel.errors.get(k);
+            s.x.iter()
+                .zip(s.y)
+                .enumerate()
+                .filter_map(move |(i, (&x, &y))| {
+                    let e = e.and_then(|e| e.get(i)).copied().unwrap_or(0.0);
+                    (e.is_finite() && e > 0.0 && y.is_finite()).then_some((k, x, y - e, y + e))
+                })
+        })
+        .collect()
+}
+
+#[allow(clippy::too_many_arguments)]
+fn draw_stacked(
+    path: &Path,
+    size: (u32, u32),
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    panels: &[Panel],
+    layout: &Layout,
 ) -> DrawResult<()> {
-    let (root, areas) = canvas(path, (WIDTH, height), title, (panels.len().max(1), 1))?;
-    for (p, ((panel_title, series), area)) in panels.iter().zip(areas).enumerate() {
-        let (x_range, mut y_range) = ranges(series);
-        let cap = 0.01 * (x_range.end - x_range.start);
-        let bars: Vec<(usize, f64, f64, f64)> = series
-            .iter()
-            .enumerate()
-            .flat_map(|(k, s)| {
-                let e = errors.get(p).and_then(|e| e.get(k));
-                s.x.iter()
-                    .zip(s.y)
-                    .enumerate()
-                    .filter_map(move |(i, (&x, &y))| {
-                        let e = e.and_then(|e| e.get(i)).copied().unwrap_or(0.0);
-                        (e.is_finite() && e > 0.0 && y.is_finite()).then_some((k, x, y - e, y + e))
-                    })
-            })
-            .collect();
-        for &(_, _, lo, hi) in &bars {
-            y_range = y_range.start.min(lo)..y_range.end.max(hi);
+    // every y value and error bound, per panel: the ranges, the unit, the scale
+    let y_values = |p: &Panel| -> Vec<f64> {
+        let mut v: Vec<f64> = p.series.iter().flat_map(|s| s.y.iter().copied()).collect();
+        for (_, _, lo, hi) in error_points(p) {
+            v.extend([lo, hi]);
         }
+        for m in &p.marks {
+            if let Mark::Level { y, .. } = m {
+                v.push(*y);
+            }
+        }
+        v.retain(|v| v.is_finite());
+        v
+    };
+    let all_y: Vec<f64> = panels.iter().flat_map(y_values).collect();
+    let log = match layout.y_scale {
+        YScale::Log => true,
+        YScale::Linear => false,
+        YScale::Auto => spans_decades(
+            panels
+                .iter()
+                .flat_map(|p| p.series.iter().flat_map(|s| s.y.iter().copied())),
+        ),
+    };
+    let ty = |v: f64| if log { v.log10() } else { v };
+    let y_range_of = |values: &[f64]| {
+        let t: Vec<f64> = values
+            .iter()
+            .filter(|v| !log || **v > 0.0)
+            .map(|&v| ty(v))
+            .collect();
+        padded(
+            t.iter().copied().fold(f64::INFINITY, f64::min),
+            t.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        )
+    };
+    let magnitude = all_y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let (root, areas) = canvas(path, size, title, (panels.len().max(1), 1))?;
+    for (panel, area) in panels.iter().zip(areas) {
+        let series = &panel.series;
+        let (mut x_range, _) = ranges(series);
+        for m in &panel.marks {
+            let xs: Vec<f64> = match m {
+                Mark::At { x, .. } => vec![*x],
+                Mark::Percentile { x, low, high, .. } => {
+                    [Some(*x), *low, *high].into_iter().flatten().collect()
+                }
+                Mark::Level { .. } => vec![],
+            };
+            for x in xs.into_iter().filter(|x| x.is_finite()) {
+                x_range = x_range.start.min(x)..x_range.end.max(x);
+            }
+        }
+        let y_range = if layout.same_y_limits {
+            y_range_of(&all_y)
+        } else {
+            y_range_of(&y_values(panel))
+        };
+        let cap = 0.01 * (x_range.end - x_range.start);
+        let mut keys = keys(series, layout.dashed_last);
+        let mut mark_labels: Vec<&str> = Vec::new();
+        for m in &panel.marks {
+            if !m.label().is_empty() && !mark_labels.contains(&m.label()) {
+                mark_labels.push(m.label());
+            }
+        }
+        let mark_style = |label: &str| -> (RGBColor, bool) {
+            let i = mark_labels.iter().position(|l| *l == label).unwrap_or(0);
+            match panel.marks.iter().find(|m| m.label() == label) {
+                Some(Mark::Level { .. }) => (RGBColor(200, 0, 0), true),
+                Some(Mark::At { .. }) => {
+                    // the vertical lines' kinds told apart: grey, then brown, purple
+                    let kind = mark_labels[..i]
+                        .iter()
+                        .filter(|l| {
+                            matches!(
+                                panel.marks.iter().find(|m| m.label() == **l),
+                                Some(Mark::At { .. })
+                            )
+                        })
+                        .count();
+                    let colours = [RGBColor(110, 110, 110), COLOURS[5], COLOURS[4]];
+                    (colours[kind % colours.len()], true)
+                }
+                _ => (COLOURS[(series.len() + i) % COLOURS.len()], false),
+            }
+        };
+        for label in &mark_labels {
+            let (colour, dashed) = mark_style(label);
+            keys.push(Key {
+                label: label.to_string(),
+                colour,
+                dashed,
+            });
+        }
+        let x_scale = match layout.x_magnitude {
+            Some(m) => Scale::LinearFor(m),
+            None => Scale::Linear,
+        };
+        let y_scale = if log {
+            Scale::Log10
+        } else if layout.same_y_unit {
+            Scale::LinearFor(magnitude)
+        } else {
+            Scale::Linear
+        };
+        let zeros = log && series.iter().any(|s| s.y.contains(&0.0));
+        let caption = if zeros {
+            format!("{} (values of 0 not drawn on the log axis)", panel.title)
+        } else {
+            panel.title.clone()
+        };
         let mut chart = frame(
             &area,
-            panel_title,
-            &keys(series, dashed_last),
-            AxisSpec::new(x_label, x_range, Scale::Linear),
-            AxisSpec::new(y_label, y_range, Scale::Linear),
+            &caption,
+            &keys,
+            AxisSpec::new(x_label, x_range.clone(), x_scale),
+            AxisSpec::new(y_label, y_range.clone(), y_scale),
         )?;
+        let bars = error_points(panel);
+        if layout.bands {
+            for k in 0..series.len() {
+                let (colour, _) = style_of(k, series.len(), layout.dashed_last);
+                let band: Vec<(f64, f64, f64)> = bars
+                    .iter()
+                    .filter(|b| b.0 == k && (!log || b.2 > 0.0))
+                    .map(|b| (b.1, ty(b.2), ty(b.3)))
+                    .collect();
+                if band.len() >= 2 {
+                    let outline: Vec<(f64, f64)> = band
+                        .iter()
+                        .map(|b| (b.0, b.2))
+                        .chain(band.iter().rev().map(|b| (b.0, b.1)))
+                        .collect();
+                    chart.draw_series(std::iter::once(Polygon::new(
+                        outline,
+                        colour.mix(0.2).filled(),
+                    )))?;
+                    record(|r| r.bands.push((series[k].label.clone(), band.len())));
+                }
+            }
+        }
         for (k, s) in series.iter().enumerate() {
-            let points = decimate(s.x, s.y, 4 * WIDTH as usize);
-            let (colour, dashed) = style_of(k, series.len(), dashed_last);
+            let points: Vec<(f64, f64)> = decimate(s.x, s.y, 4 * WIDTH as usize)
+                .into_iter()
+                .filter(|p| !log || p.1 > 0.0)
+                .map(|(x, y)| (x, ty(y)))
+                .collect();
+            let (colour, dashed) = style_of(k, series.len(), layout.dashed_last);
+            let largest =
+                s.y.iter()
+                    .filter(|v| v.is_finite())
+                    .fold(0.0f64, |m, v| m.max(v.abs()));
+            let marked = !dashed && points.len() <= MARKED_POINTS;
+            record(|r| {
+                r.series
+                    .push((s.label.clone(), points.len(), largest, marked))
+            });
             // Width 1: plotters draws wider lines as polygons whose miter joins spike on
             // zig-zag data (an alternating force).
             let style = colour.stroke_width(1);
@@ -635,7 +1165,7 @@ fn panels(
             } else {
                 // a few points (a study, a convergence): marked, the earlier series' marks
                 // larger so that equal points of several series all show
-                if points.len() <= MARKED_POINTS {
+                if marked {
                     let radius = 3 + (series.len() - 1 - k).min(4) as i32;
                     let marks = points
                         .iter()
@@ -645,9 +1175,65 @@ fn panels(
                 chart.draw_series(LineSeries::new(points, style))?;
             }
         }
-        for &(k, x, lo, hi) in &bars {
-            let (colour, _) = style_of(k, series.len(), dashed_last);
-            chart.draw_series(error_bar(x, lo, hi, cap, colour))?;
+        if !layout.bands {
+            for &(k, x, lo, hi) in &bars {
+                let (colour, _) = style_of(k, series.len(), layout.dashed_last);
+                // on a log axis a bar reaching zero or below stops a decade under the point
+                let lo = if log && lo <= 0.0 {
+                    (lo + hi) / 20.0
+                } else {
+                    lo
+                };
+                chart.draw_series(error_bar(x, ty(lo), ty(hi), cap, colour))?;
+                record(|r| r.error_bars.push((x, lo, hi, true)));
+            }
+        }
+        for m in &panel.marks {
+            let (colour, _) = mark_style(m.label());
+            match m {
+                Mark::Level { label, y } => {
+                    let y = ty(*y);
+                    let line = [(x_range.start, y), (x_range.end, y)];
+                    chart.draw_series(DashedLineSeries::new(line, 8, 5, colour.stroke_width(2)))?;
+                    let at = if log { 10f64.powf(y) } else { y };
+                    record(|r| r.lines.push((label.clone(), at, false)));
+                }
+                Mark::At { label, x } => {
+                    let line = [(*x, y_range.start), (*x, y_range.end)];
+                    chart.draw_series(DashedLineSeries::new(line, 6, 4, colour.stroke_width(1)))?;
+                    record(|r| r.lines.push((label.clone(), *x, true)));
+                }
+                Mark::Percentile {
+                    label,
+                    x,
+                    level,
+                    low,
+                    high,
+                } => {
+                    let style = colour.stroke_width(2);
+                    let level_y = ty(*level);
+                    chart.draw_series(std::iter::once(PathElement::new(
+                        vec![(*x, if log { y_range.start } else { 0.0 }), (*x, level_y)],
+                        style,
+                    )))?;
+                    record(|r| r.lines.push((label.clone(), *x, true)));
+                    let (a, b) = (low.unwrap_or(x_range.start), high.unwrap_or(x_range.end));
+                    let h = 0.02 * (y_range.end - y_range.start);
+                    chart.draw_series(std::iter::once(PathElement::new(
+                        vec![(a, level_y), (b, level_y)],
+                        style,
+                    )))?;
+                    for (bound, at) in [(low, a), (high, b)] {
+                        if bound.is_some() {
+                            chart.draw_series(std::iter::once(PathElement::new(
+                                vec![(at, level_y - h), (at, level_y + h)],
+                                style,
+                            )))?;
+                        }
+                    }
+                    record(|r| r.error_bars.push((*level, a, b, false)));
+                }
+            }
         }
     }
     root.present()?;
@@ -719,15 +1305,36 @@ pub fn xy_panels(
 }
 
 /// Stacked panels of bar charts, one per entry (panel title, bars, labelled under the x axis);
-/// 300 px each.
+/// 300 px each. The panels are compared: one unit and one range on their y axes.
 pub fn bar_panels(
     path: &Path,
     title: &str,
     y_label: &str,
     panels: &[(String, Vec<Bar>)],
 ) -> Result<(), String> {
-    let backend = BitMapBackend::new(path, stacked_size(panels.len()));
+    let backend = BitMapBackend::new(path, titled_size(stacked_size(panels.len()), title));
     finish(path, draw_bars(backend, title, y_label, panels))
+}
+
+/// Below this fraction of the largest value of a bar chart a value is round-off (a sum of
+/// products over up to 10⁸ steps accumulates ~10⁻⁸ of its terms' size; a bar that short is
+/// under a pixel): it reads 0, without an error bar.
+pub const ROUND_OFF: f64 = 1e-8;
+
+/// A bar's value and error as drawn: non-finite → 0; round-off ([`ROUND_OFF`] of `largest`)
+/// → 0 without an error bar.
+pub fn bar_as_drawn(b: &Bar, largest: f64) -> (f64, f64) {
+    let value = if b.value.is_finite() { b.value } else { 0.0 };
+    let error = if b.error.is_finite() {
+        b.error.abs()
+    } else {
+        0.0
+    };
+    if value.abs() <= ROUND_OFF * largest {
+        (0.0, 0.0)
+    } else {
+        (value, error)
+    }
 }
 
 fn draw_bars(
@@ -737,38 +1344,64 @@ fn draw_bars(
     panels: &[(String, Vec<Bar>)],
 ) -> DrawResult<()> {
     let (root, areas) = canvas_on(backend, title, (panels.len().max(1), 1))?;
-    for ((panel_title, bars), area) in panels.iter().zip(areas) {
+    let largest = panels
+        .iter()
+        .flat_map(|(_, bars)| bars.iter().map(|b| b.value.abs()))
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    let drawn: Vec<Vec<(f64, f64)>> = panels
+        .iter()
+        .map(|(_, bars)| bars.iter().map(|b| bar_as_drawn(b, largest)).collect())
+        .collect();
+    let top = drawn
+        .iter()
+        .flatten()
+        .map(|(v, e)| v + e)
+        .fold(0.0, f64::max);
+    let bottom = drawn
+        .iter()
+        .flatten()
+        .map(|(v, e)| v - e)
+        .fold(0.0, f64::min);
+    let (bottom, top) = if top > bottom {
+        (1.1 * bottom, 1.1 * top)
+    } else {
+        (0.0, 1.0)
+    };
+    let magnitude = bottom.abs().max(top.abs());
+    for (((panel_title, bars), values), area) in panels.iter().zip(&drawn).zip(areas) {
         let names: Vec<String> = bars.iter().map(|b| b.label.clone()).collect();
-        let value = |b: &Bar| if b.value.is_finite() { b.value } else { 0.0 };
-        let error = |b: &Bar| {
-            if b.error.is_finite() {
-                b.error.abs()
-            } else {
-                0.0
-            }
-        };
-        let top = bars.iter().map(|b| value(b) + error(b)).fold(0.0, f64::max);
-        let bottom = bars.iter().map(|b| value(b) - error(b)).fold(0.0, f64::min);
-        let (bottom, top) = if top > bottom {
-            (1.1 * bottom, 1.1 * top)
-        } else {
-            (0.0, 1.0)
-        };
         let mut chart = frame(
             &area,
             panel_title,
             &[],
             AxisSpec::new("", 0.0..bars.len().max(1) as f64, Scale::Names(&names)),
-            AxisSpec::new(y_label, bottom..top, Scale::Linear),
+            AxisSpec::new(y_label, bottom..top, Scale::LinearFor(magnitude)),
         )?;
-        chart.draw_series(bars.iter().enumerate().map(|(i, b)| {
+        chart.draw_series(values.iter().enumerate().map(|(i, &(v, _))| {
             let x = i as f64;
-            Rectangle::new([(x + 0.1, 0.0), (x + 0.9, value(b))], COLOURS[0].filled())
+            Rectangle::new([(x + 0.1, 0.0), (x + 0.9, v)], COLOURS[0].filled())
         }))?;
+        for (i, (b, &(v, e))) in bars.iter().zip(values).enumerate() {
+            record(|r| {
+                r.bars
+                    .push((b.label.clone(), v, e, i as f64 + 0.1, i as f64 + 0.9))
+            });
+            if v == 0.0 {
+                // a bar of zero height: its value written
+                let style = TextStyle::from(("sans-serif", 13).into_font())
+                    .pos(Pos::new(HPos::Center, VPos::Bottom));
+                chart.draw_series(std::iter::once(Text::new(
+                    "0",
+                    (i as f64 + 0.5, 0.0),
+                    style,
+                )))?;
+            }
+        }
         // ± one standard error
-        for (i, b) in bars.iter().enumerate().filter(|(_, b)| error(b) > 0.0) {
-            let (x, lo, hi) = (i as f64 + 0.5, value(b) - error(b), value(b) + error(b));
-            chart.draw_series(error_bar(x, lo, hi, 0.1, BLACK))?;
+        for (i, &(v, e)) in values.iter().enumerate().filter(|(_, (_, e))| *e > 0.0) {
+            chart.draw_series(error_bar(i as f64 + 0.5, v - e, v + e, 0.1, BLACK))?;
+            record(|r| r.error_bars.push((i as f64 + 0.5, v - e, v + e, true)));
         }
     }
     root.present()?;
@@ -794,8 +1427,9 @@ pub fn histogram_panels(
     let all: Vec<_> = panels.iter().flat_map(|(_, b)| log_bins(b)).collect();
     let lo = all.iter().map(|b| b.0).fold(f64::INFINITY, f64::min);
     let hi = all.iter().map(|b| b.1).fold(f64::NEG_INFINITY, f64::max);
+    // at least a decade, so that a single bin is a bar among ticks, not the whole axis
     let x_range = if lo < hi {
-        let pad = 0.03 * (hi - lo);
+        let pad = (0.03 * (hi - lo)).max(0.5 * (1.0 - (hi - lo)));
         lo - pad..hi + pad
     } else {
         0.0..1.0
@@ -826,6 +1460,9 @@ pub fn histogram_panels(
                     COLOURS[0].filled(),
                 )
             }))?;
+            for &(a, b, count) in &bins {
+                record(|r| r.bars.push((String::new(), count as f64, 0.0, a, b)));
+            }
             Ok(())
         },
     )
@@ -852,6 +1489,23 @@ fn draw_panels<P>(
     finish(path, drawn())
 }
 
+/// `lo..hi` with 5 % margins (a single value: ±50 % of it, or ±1 for 0); 0..1 when not
+/// finite.
+fn padded(lo: f64, hi: f64) -> Range<f64> {
+    if !(lo.is_finite() && hi.is_finite()) {
+        return 0.0..1.0;
+    }
+    let span = hi - lo;
+    let pad = if span > 0.0 {
+        0.05 * span
+    } else if lo != 0.0 {
+        0.5 * lo.abs()
+    } else {
+        1.0
+    };
+    (lo - pad)..(hi + pad)
+}
+
 /// Axis ranges from the finite data, with 5 % margins; never empty.
 fn ranges(series: &[Series]) -> (Range<f64>, Range<f64>) {
     let bounds = |vals: &mut dyn Iterator<Item = f64>| {
@@ -860,18 +1514,7 @@ fn ranges(series: &[Series]) -> (Range<f64>, Range<f64>) {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
                 (a.min(v), b.max(v))
             });
-        if !lo.is_finite() {
-            return 0.0..1.0;
-        }
-        let span = hi - lo;
-        let pad = if span > 0.0 {
-            0.05 * span
-        } else if lo != 0.0 {
-            0.5 * lo.abs()
-        } else {
-            1.0
-        };
-        (lo - pad)..(hi + pad)
+        padded(lo, hi)
     };
     (
         bounds(&mut series.iter().flat_map(|s| s.x.iter().copied())),

@@ -11,12 +11,49 @@
 
 use std::path::{Path, PathBuf};
 
+use fretdyn::apps::percentiles::{PercentileReport, PercentileRow};
 use ndarray::{Array1, Array2, Array3, Ix1, Ix2, Ix3};
 use ndarray_npy::{NpzReader, ReadNpyExt};
 use serde_json::Value;
 
 use crate::Failure;
-use crate::plot::{Bar, Bin, Series, bar_panels, histogram_panels, panels_plot, xy_panels};
+use crate::plot::{
+    Bar, Bin, Layout, Mark, Panel, Series, YScale, bar_panels, histogram_panels, panels_plot,
+    stacked, xy_panels,
+};
+
+/// What a contact's displacement is measured from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Obstacle {
+    /// A hole: the radial offset from its centre.
+    Hole,
+    /// A plane whose face is at `gap` from the plane through its origin.
+    Plane { gap: f64 },
+    /// Two bars at ±`gap` from their mid-plane.
+    Bars { gap: f64 },
+    /// Unknown (a summary without the case): the coordinate as written.
+    Other,
+}
+
+/// The obstacle of contact `k`, from `summary.json`'s geometry and the case echoed in it
+/// (`gap` absent: 0, the case's default).
+fn obstacle_of(summary: &Value, geometry: &[Value], k: usize) -> Obstacle {
+    if geometry.get(k).is_some_and(|g| !g["outline"].is_null()) {
+        return Obstacle::Hole;
+    }
+    let name = geometry.get(k).map(|g| &g["name"]);
+    let contacts = summary["case"]["contacts"].as_array();
+    let echoed = contacts
+        .and_then(|c| c.iter().find(|c| Some(&c["name"]) == name))
+        .or_else(|| contacts.and_then(|c| c.get(k)))
+        .map_or(&Value::Null, |c| &c["obstacle"]);
+    let gap = echoed["gap"].as_f64().unwrap_or(0.0);
+    match geometry.get(k).and_then(|g| g["obstacle"].as_str()) {
+        Some("plane") => Obstacle::Plane { gap },
+        Some("bi_plane") => Obstacle::Bars { gap },
+        _ => Obstacle::Other,
+    }
+}
 
 /// The time histories the plots need.
 struct Histories {
@@ -183,42 +220,76 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
     .map_err(fail)?;
     written.push(path);
 
-    // displacement at the contacts
+    // displacement at the contacts: for a plane, the distance from its face (at `gap` from
+    // the plane through `origin`, contact below 0); for bars, the position from their
+    // mid-plane with the faces at ±gap
     let is_hole = |k: usize| geometry.get(k).is_some_and(|g| !g["outline"].is_null());
+    let obstacles: Vec<Obstacle> = (0..nc)
+        .map(|k| obstacle_of(&summary, &geometry, k))
+        .collect();
     let displacement: Vec<Vec<f64>> = (0..nc)
         .map(|k| {
             (0..h.t.len())
                 .map(|i| {
                     let (x, y) = (h.position[[i, k, 0]], h.position[[i, k, 1]]);
-                    if is_hole(k) { x.hypot(y) } else { x }
+                    match obstacles[k] {
+                        Obstacle::Hole => x.hypot(y),
+                        Obstacle::Plane { gap } => x + gap,
+                        Obstacle::Bars { .. } | Obstacle::Other => x,
+                    }
                 })
                 .collect()
         })
         .collect();
-    let panels: Vec<(String, Vec<Series>)> = (0..nc)
+    let panels: Vec<Panel> = (0..nc)
         .map(|k| {
-            let label = if is_hole(k) {
-                "radial offset from the hole's centre"
-            } else {
-                "distance from the plane"
+            let (label, marks) = match obstacles[k] {
+                Obstacle::Hole => ("radial offset from the hole's centre", vec![]),
+                Obstacle::Plane { .. } => (
+                    "distance from the obstacle's face (contact below 0)",
+                    vec![Mark::Level {
+                        label: "face (at gap)".into(),
+                        y: 0.0,
+                    }],
+                ),
+                Obstacle::Bars { gap } => (
+                    "position from the bars' mid-plane",
+                    vec![
+                        Mark::Level {
+                            label: "faces (±gap)".into(),
+                            y: gap,
+                        },
+                        Mark::Level {
+                            label: "faces (±gap)".into(),
+                            y: -gap,
+                        },
+                    ],
+                ),
+                Obstacle::Other => ("distance from the plane", vec![]),
             };
-            (
-                names[k].clone(),
-                vec![Series {
+            Panel {
+                title: names[k].clone(),
+                series: vec![Series {
                     label: label.into(),
                     x: &t,
                     y: &displacement[k],
                 }],
-            )
+                errors: Vec::new(),
+                marks,
+            }
         })
         .collect();
     let path = dir.join("contact_displacement.png");
-    panels_plot(
+    stacked(
         &path,
         &format!("{title} — displacement at the contacts"),
         "t (s)",
         "displacement (m)",
         &panels,
+        &Layout {
+            y_scale: YScale::Linear,
+            ..Layout::default()
+        },
     )
     .map_err(fail)?;
     written.push(path);
@@ -286,7 +357,10 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, Failure> {
             .filter(|&k| !peaks[k].is_empty())
             .map(|k| {
                 (
-                    format!("{} ({} impacts)", names[k], peaks[k].len()),
+                    match peaks[k].len() {
+                        1 => format!("{} (1 impact)", names[k]),
+                        n => format!("{} ({n} impacts)", names[k]),
+                    },
                     histogram(&peaks[k], 5),
                 )
             })
@@ -373,4 +447,165 @@ fn histogram(values: &[f64], per_decade: usize) -> Vec<Bin> {
             }
         })
         .collect()
+}
+
+/// The kinds of folder fretdyn writes, by the file that tells them apart.
+const FOLDER_KINDS: [(&str, &str); 4] = [
+    ("summary.json", "a run"),
+    ("study.csv", "a study (sweep)"),
+    ("life.json", "a life"),
+    (crate::modes::SHAPES_FILE, "a modes folder"),
+];
+
+/// Draws again every figure of a folder fretdyn wrote — a run, a study (`study.png` and
+/// `percentiles.png`), a life or a modes folder —, its kind told by the files in it; returns
+/// the files written. `y_scale`: the y axis of a study's `study.png`.
+pub fn plot_folder(dir: &Path, y_scale: YScale) -> Result<Vec<PathBuf>, Failure> {
+    if !dir.is_dir() {
+        return Err(Failure::input(format!(
+            "{}: no such folder (give a folder written by fretdyn run, sweep, life or modes)",
+            dir.display()
+        )));
+    }
+    let has = |name: &str| dir.join(name).is_file();
+    if has("summary.json") {
+        return plot_run(dir);
+    }
+    let mut written = Vec::new();
+    if has("study.csv") {
+        written.extend(plot_study(dir, y_scale)?);
+    }
+    if has("life.json") && has("life.csv") {
+        written.push(crate::life::draw_folder(dir).map_err(Failure::failed)?);
+    }
+    if has(crate::modes::SHAPES_FILE) {
+        written.push(crate::modes::draw_folder(dir).map_err(Failure::failed)?);
+    }
+    if written.is_empty() && !FOLDER_KINDS.iter().any(|(f, _)| has(f)) {
+        let kinds: Vec<String> = FOLDER_KINDS
+            .iter()
+            .map(|(f, k)| format!("{k}: {f}"))
+            .collect();
+        return Err(Failure::input(format!(
+            "{}: nothing fretdyn wrote is in this folder ({}); a modes folder written before {} was added: run fretdyn modes again",
+            dir.display(),
+            kinds.join(", "),
+            crate::modes::SHAPES_FILE
+        )));
+    }
+    Ok(written)
+}
+
+/// `study.png` and `percentiles.png` of a study folder, as `fretdyn sweep` drew them (from
+/// its `figures.json`; a folder without one: the first parameter of the table on x and the
+/// wear work rate, when the table has it).
+fn plot_study(dir: &Path, y_scale: YScale) -> Result<Vec<PathBuf>, Failure> {
+    use crate::sweep::{FIGURES_FILE, plot_percentiles, plot_table};
+    let table = dir.join("study.csv");
+    let figures: Value = std::fs::read_to_string(dir.join(FIGURES_FILE))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or(Value::Null);
+    let text = std::fs::read_to_string(&table)
+        .map_err(|e| Failure::input(format!("{}: {e}", table.display())))?;
+    let header: Vec<String> = text
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let status = header.iter().position(|h| h == "status");
+    let Some(status) = status.filter(|&s| s > 1) else {
+        return Err(Failure::input(format!(
+            "{}: not a study table of fretdyn sweep (no parameter and status columns)",
+            table.display()
+        )));
+    };
+    let per_contact =
+        |statistic: &str| header.iter().any(|h| h.ends_with(&format!(".{statistic}")));
+    let mut written = Vec::new();
+    let study = &figures["study"];
+    let (x, statistic, labels) = if study.is_object() {
+        (
+            study["x"].as_str().unwrap_or_default().to_string(),
+            study["statistic"].as_str().unwrap_or_default().to_string(),
+            study["labels"]
+                .as_array()
+                .map(|a| {
+                    a.iter()
+                        .filter_map(|v| v.as_str().map(str::to_string))
+                        .collect()
+                })
+                .unwrap_or_default(),
+        )
+    } else {
+        (
+            header[1].clone(),
+            "wear_work_rate".to_string(),
+            header[1..status].to_vec(),
+        )
+    };
+    if per_contact(&statistic) && header.contains(&x) {
+        let path = dir.join("study.png");
+        plot_table(&table, &x, &statistic, &labels, y_scale, &path)?;
+        written.push(path);
+    }
+    let json = dir.join("percentiles.json");
+    if json.is_file() {
+        let report = read_percentiles(&json).map_err(Failure::input)?;
+        let statistic = figures["percentiles"]["statistic"]
+            .as_str()
+            .map(str::to_string)
+            .or_else(|| {
+                report
+                    .rows
+                    .first()
+                    .and_then(|r| r.column.rsplit_once('.').map(|(_, s)| s.to_string()))
+            });
+        if let Some(statistic) = statistic {
+            let path = dir.join("percentiles.png");
+            plot_percentiles(&table, &report, &statistic, &path)?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}
+
+/// A study's percentiles read back from its `percentiles.json` (a `null` estimate: NaN).
+fn read_percentiles(path: &Path) -> Result<PercentileReport, String> {
+    let json: Value = std::fs::read_to_string(path)
+        .map_err(|e| e.to_string())
+        .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let rows = json["rows"]
+        .as_array()
+        .ok_or_else(|| format!("{}: no 'rows' list", path.display()))?;
+    Ok(PercentileReport {
+        confidence: json["confidence"].as_f64().unwrap_or(0.95),
+        bootstrap_resamples: json["bootstrap_resamples"].as_u64().unwrap_or(0) as usize,
+        seed: json["seed"].as_u64().unwrap_or(0),
+        rows: rows
+            .iter()
+            .map(|r| PercentileRow {
+                group: r["group"]
+                    .as_object()
+                    .map(|g| {
+                        g.iter()
+                            .map(|(k, v)| (k.clone(), v.as_str().unwrap_or_default().to_string()))
+                            .collect()
+                    })
+                    .unwrap_or_default(),
+                column: r["column"].as_str().unwrap_or_default().to_string(),
+                level: r["level"].as_f64().unwrap_or(f64::NAN),
+                n: r["n"].as_u64().unwrap_or(0) as usize,
+                excluded: r["excluded"].as_u64().unwrap_or(0) as usize,
+                estimate: r["estimate"].as_f64().unwrap_or(f64::NAN),
+                ci_low: r["ci_low"].as_f64(),
+                ci_high: r["ci_high"].as_f64(),
+                ci_coverage: r["ci_coverage"].as_f64().unwrap_or(f64::NAN),
+                bootstrap_se: r["bootstrap_se"].as_f64().unwrap_or(f64::NAN),
+            })
+            .collect(),
+    })
 }

@@ -7,13 +7,13 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use fretdyn::apps::percentiles::PercentileReport;
+use fretdyn::apps::percentiles::{PercentileReport, PercentileRow};
 use fretdyn::apps::study::{CONNORS_COLUMN, Study, StudyOptions, connors_exceedance};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Failure;
 use crate::out::{errln, outln};
-use crate::plot::{Series, panels_plot, panels_plot_with_errors};
+use crate::plot::{Layout, Mark, Panel, Series, YScale, stacked, unit_for};
 
 /// Most runs at a time (`-j`) on a machine of `cores` cores: four per core, and at least
 /// 64 (each is a thread with its own simulation; more only cost their start).
@@ -24,12 +24,18 @@ pub fn max_jobs(cores: usize) -> usize {
 /// What a study writes in its folder beside its table, from the table: removed before runs
 /// are added (so that a stopped study never leaves the figures of an earlier table) and
 /// written again at its end.
-const DERIVED: [&str; 4] = [
+const DERIVED: [&str; 5] = [
     "percentiles.csv",
     "percentiles.json",
     "percentiles.png",
     "study.png",
+    FIGURES_FILE,
 ];
+
+/// What a study's figures are drawn from (`study.png`: the parameter on x, the statistic,
+/// the columns labelling the lines; `percentiles.png`: the statistic), written beside its
+/// table so that `fretdyn plot DIR` draws them again.
+pub const FIGURES_FILE: &str = "figures.json";
 
 /// Entry point of `fretdyn sweep`.
 pub fn main(
@@ -141,6 +147,8 @@ pub fn main(
             table.display()
         );
     }
+    // what the figures are drawn from, for `fretdyn plot DIR`
+    let mut figures = serde_json::json!({});
     if let Some(plot) = &s.plot {
         // the lines are labelled by the values parameters and the seed, not by the draws
         let labels: Vec<String> = s
@@ -155,8 +163,14 @@ pub fn main(
             &plot.x,
             &plot.statistic,
             &labels,
+            YScale::Auto,
             &dir.join("study.png"),
         )?;
+        figures["study"] = serde_json::json!({
+            "x": plot.x,
+            "statistic": plot.statistic,
+            "labels": labels,
+        });
     }
     // percentiles across the samples, from the table (docs/STUDIES.md)
     let report = s
@@ -168,7 +182,13 @@ pub fn main(
             .map_err(|e| Failure::failed(e.to_string()))?;
         if let Some(statistic) = s.percentiles.as_ref().and_then(|p| p.statistics.first()) {
             plot_percentiles(&table, report, statistic, &dir.join("percentiles.png"))?;
+            figures["percentiles"] = serde_json::json!({ "statistic": statistic });
         }
+    }
+    if figures.as_object().is_some_and(|f| !f.is_empty()) {
+        let p = dir.join(FIGURES_FILE);
+        fretdyn::files::write_text_atomically(&p, &format!("{figures:#}\n"))
+            .map_err(|e| Failure::failed(e.to_string()))?;
     }
     if !quiet {
         outln!(
@@ -194,11 +214,12 @@ type Line = (String, Vec<f64>, Vec<f64>);
 
 /// One panel per contact: `statistic` against the parameter `x`, one line per combination
 /// of the other `labels` columns (the `values` parameters and the seed).
-fn plot_table(
+pub fn plot_table(
     table: &Path,
     x: &str,
     statistic: &str,
     labels: &[String],
+    y_scale: YScale,
     path: &Path,
 ) -> Result<(), Failure> {
     let text = std::fs::read_to_string(table)
@@ -288,18 +309,29 @@ fn plot_table(
             )
         })
         .collect();
-    let (x_name, _) = parameter_name(x);
     let (y_name, _) = statistic_name(statistic);
-    panels_plot_with_errors(
+    let panels: Vec<Panel> = panels
+        .into_iter()
+        .zip(errors)
+        .map(|((title, series), errors)| Panel {
+            title,
+            series,
+            errors,
+            marks: Vec::new(),
+        })
+        .collect();
+    // the contacts' panels are compared: one unit; a log axis when the values span decades
+    stacked(
         path,
-        &format!(
-            "{} against {x_name} (± standard error)",
-            capitalised(&y_name)
-        ),
+        &format!("{} against {x} (± standard error)", capitalised(&y_name)),
         &parameter_label(x),
         &y_label,
         &panels,
-        &errors,
+        &Layout {
+            same_y_unit: true,
+            y_scale,
+            ..Layout::default()
+        },
     )
     .map_err(Failure::failed)
 }
@@ -307,7 +339,7 @@ fn plot_table(
 /// One panel per column of `statistic` (per contact): the empirical distribution function of
 /// the completed runs' values (one line per group of the report), and each percentile of the
 /// report as a vertical segment up to its level, labelled with its interval.
-fn plot_percentiles(
+pub fn plot_percentiles(
     table: &Path,
     report: &PercentileReport,
     statistic: &str,
@@ -332,32 +364,19 @@ fn plot_percentiles(
             columns.push(&r.column);
         }
     }
-    // (x, y) of every line, kept alive for the borrowed series
-    let mut data: Vec<(String, Vec<Line>)> = Vec::new();
-    let unit = statistic_name(statistic).1;
-    let value = |x: f64| {
-        if unit.is_empty() {
-            format!("{x:.3e}")
-        } else {
-            format!("{x:.3e} {unit}")
-        }
-    };
+    // (x, y) of every line, kept alive for the borrowed series, and the percentiles' marks
+    let mut data: Vec<(String, Vec<Line>, Vec<&PercentileRow>)> = Vec::new();
     for column in &columns {
         let Some(col) = at(column) else { continue };
         let mut lines = Vec::new();
+        let mut marks = Vec::new();
         let mut groups: Vec<&Vec<(String, String)>> = Vec::new();
         for r in report.rows.iter().filter(|r| r.column == *column) {
             if !groups.contains(&&r.group) {
                 groups.push(&r.group);
             }
         }
-        let several = groups.len() > 1;
         for group in groups {
-            let label = group
-                .iter()
-                .map(|(k, v)| parameter_value(k, v))
-                .collect::<Vec<_>>()
-                .join(", ");
             let mut x: Vec<f64> = rows
                 .iter()
                 .filter(|r| r[status] == "completed")
@@ -368,42 +387,56 @@ fn plot_percentiles(
             x.sort_by(f64::total_cmp);
             let n = x.len() as f64;
             let y: Vec<f64> = (1..=x.len()).map(|i| i as f64 / n).collect();
-            let prefix = if label.is_empty() || !several {
-                String::new()
-            } else {
-                format!("{label}: ")
-            };
-            lines.push((format!("{prefix}{} runs", x.len()), x, y));
-            for r in report
-                .rows
-                .iter()
-                .filter(|r| r.column == *column && &r.group == group && r.estimate.is_finite())
-            {
-                let bound = |b: Option<f64>| b.map_or("–".to_string(), value);
-                lines.push((
-                    format!(
-                        "{prefix}P{} = {} [{}, {}]",
-                        r.level,
-                        value(r.estimate),
-                        bound(r.ci_low),
-                        bound(r.ci_high)
-                    ),
-                    vec![r.estimate, r.estimate],
-                    vec![0.0, r.level / 100.0],
-                ));
-            }
+            lines.push((group_prefix(group, x.len()), x, y));
+            marks.extend(
+                report
+                    .rows
+                    .iter()
+                    .filter(|r| r.column == *column && &r.group == group && r.estimate.is_finite()),
+            );
         }
         let contact = column
             .strip_suffix(&format!(".{statistic}"))
             .unwrap_or(column);
-        data.push((contact.to_string(), lines));
+        data.push((contact.to_string(), lines, marks));
     }
-    let panels: Vec<(String, Vec<Series>)> = data
+    // the values in the legend in the x axis' unit: one prefix for every panel
+    let x_label = statistic_label(statistic);
+    let magnitude = data
         .iter()
-        .map(|(c, lines)| {
-            (
-                c.clone(),
-                lines
+        .flat_map(|(_, lines, marks)| {
+            lines
+                .iter()
+                .flat_map(|l| l.1.iter().copied())
+                .chain(marks.iter().flat_map(|r| {
+                    [Some(r.estimate), r.ci_low, r.ci_high]
+                        .into_iter()
+                        .flatten()
+                }))
+        })
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let (unit, factor) = unit_for(&x_label, magnitude);
+    let value = |x: f64| {
+        let v = format!("{:.3}", x / factor);
+        if unit.is_empty() {
+            v
+        } else {
+            format!("{v} {unit}")
+        }
+    };
+    let groups = |marks: &[&PercentileRow]| {
+        let mut g: Vec<&Vec<(String, String)>> = marks.iter().map(|r| &r.group).collect();
+        g.dedup();
+        g.len()
+    };
+    let panels: Vec<Panel> = data
+        .iter()
+        .map(|(c, lines, marks)| {
+            let several = groups(marks) > 1;
+            Panel {
+                title: c.clone(),
+                series: lines
                     .iter()
                     .map(|(label, x, y)| Series {
                         label: label.clone(),
@@ -411,21 +444,69 @@ fn plot_percentiles(
                         y,
                     })
                     .collect(),
-            )
+                errors: Vec::new(),
+                marks: marks
+                    .iter()
+                    .map(|r| {
+                        let prefix = if several {
+                            format!("{}: ", group_label(&r.group))
+                        } else {
+                            String::new()
+                        };
+                        let bound = |b: Option<f64>| b.map_or("–".to_string(), value);
+                        Mark::Percentile {
+                            label: format!(
+                                "{prefix}P{} = {} [{}, {}]",
+                                r.level,
+                                value(r.estimate),
+                                bound(r.ci_low),
+                                bound(r.ci_high)
+                            ),
+                            x: r.estimate,
+                            level: r.level / 100.0,
+                            low: r.ci_low,
+                            high: r.ci_high,
+                        }
+                    })
+                    .collect(),
+            }
         })
         .collect();
     let (name, _) = statistic_name(statistic);
-    panels_plot(
+    stacked(
         path,
         &format!(
             "Distribution of the {name} over the samples, percentiles with their {:.0} % intervals",
             100.0 * report.confidence
         ),
-        &statistic_label(statistic),
+        &x_label,
         "fraction of the runs ≤ x",
         &panels,
+        &Layout {
+            y_scale: YScale::Linear,
+            x_magnitude: Some(magnitude),
+            ..Layout::default()
+        },
     )
     .map_err(Failure::failed)
+}
+
+/// The legend words of a group of runs: `clearance = 0.0002 m, mu = 0.3`.
+fn group_label(group: &[(String, String)]) -> String {
+    group
+        .iter()
+        .map(|(k, v)| parameter_value(k, v))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The label of a group's distribution function: `<group>: 40 runs`.
+fn group_prefix(group: &[(String, String)], runs: usize) -> String {
+    if group.is_empty() {
+        format!("{runs} runs")
+    } else {
+        format!("{}: {runs} runs", group_label(group))
+    }
 }
 
 fn capitalised(s: &str) -> String {
@@ -478,6 +559,8 @@ fn parameter_name(key: &str) -> (String, &'static str) {
         "f_max" | "max_frequency_hz" => "Hz",
         "force" => "N",
         "acceleration" => "m/s²",
+        "velocity" | "mean_velocity" | "gap_velocity" => "m/s",
+        "lift_slope" | "mu" | "mu_static" | "mu_dynamic" => "",
         _ => "",
     };
     let word = match last {
@@ -502,10 +585,11 @@ fn parameter_name(key: &str) -> (String, &'static str) {
     (name, unit)
 }
 
-/// Axis label of a parameter key: its readable name and unit.
+/// Axis label of a parameter key: the key as the study writes it (a path in the case, whose
+/// indices are the user's own) and its unit.
 fn parameter_label(key: &str) -> String {
-    let (name, unit) = parameter_name(key);
-    with_unit(name, unit)
+    let (_, unit) = parameter_name(key);
+    with_unit(key.to_string(), unit)
 }
 
 /// `name = value unit` for the legend (the name without where it applies).
@@ -540,6 +624,10 @@ fn known_statistic(statistic: &str) -> Option<(&'static str, &'static str)> {
         "tangential_force_rms" => ("RMS tangential force", "N"),
         "wear_work_rate" => ("wear work rate", "W"),
         "normal_wear_work_rate" => ("wear work rate, R_N|v_T| definition", "W"),
+        "depth_at_target" => ("tube depth at the target time", "m"),
+        "depth_at_target_fixed_gap" => ("tube depth at the target time, fixed gap", "m"),
+        "time_to_criterion" => ("time to the plugging criterion", "years"),
+        "time_to_criterion_fixed_gap" => ("time to the plugging criterion, fixed gap", "years"),
         _ => return None,
     })
 }
@@ -556,25 +644,26 @@ mod tests {
 
     #[test]
     fn study_axes_are_readable_with_their_unit() {
+        // the x axis: the key as the study writes it, never an internal index, and its unit
         assert_eq!(
             parameter_label("contacts.*.obstacle.clearance"),
-            "clearance, every contact (m)"
+            "contacts.*.obstacle.clearance (m)"
         );
         assert_eq!(
-            parameter_label("contacts[0].obstacle.clearance"),
-            "clearance, contact 0 (m)"
+            parameter_label("flow.zones.0.velocity"),
+            "flow.zones.0.velocity (m/s)"
         );
         assert_eq!(
             parameter_label("contacts.2.normal.stiffness"),
-            "normal stiffness, contact 2 (N/m)"
+            "contacts.2.normal.stiffness (N/m)"
         );
         assert_eq!(
             parameter_label("contacts.*.friction.mu"),
-            "friction coefficient, every contact"
+            "contacts.*.friction.mu"
         );
-        assert_eq!(parameter_label("time.duration"), "duration (s)");
-        assert_eq!(parameter_label("time.dt"), "time step (s)");
-        assert_eq!(parameter_label("tangential.method"), "tangential method");
+        assert_eq!(parameter_label("time.duration"), "time.duration (s)");
+        assert_eq!(parameter_name("time.dt").0, "time step");
+        assert_eq!(parameter_name("flow.zones.0.velocity").1, "m/s");
         assert_eq!(
             parameter_value("tangential.method", "gauss_seidel"),
             "tangential method = gauss_seidel"
