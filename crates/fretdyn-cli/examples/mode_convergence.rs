@@ -1,9 +1,10 @@
 //! Convergence of a tube's contact forces and wear with the number of modes kept
 //! (docs/VERIFICATION.md). Runs examples/tube_clamped_one_support.toml for 0.1 s at
 //! Δt = 1e-6 s (stable with every mode) keeping 2 … 114 (all) modes, prints the table and
-//! writes docs/figures/mode_convergence.png.
+//! writes mode_convergence.png in the folder given (default: fretdyn_results/mode_convergence;
+//! scripts/regenerate_figures.sh copies it to docs/figures).
 //!
-//! cargo run --release -p fretdyn-cli --example mode_convergence
+//! cargo run --release -p fretdyn-cli --example mode_convergence [-- FOLDER]
 
 // The command's own plotting module, shared rather than copied.
 #[allow(dead_code)]
@@ -69,7 +70,12 @@ fn main() {
         .collect();
     let log = |v: &[f64]| v.iter().map(|e| e.max(1e-12).log10()).collect::<Vec<_>>();
     let (a, b, c) = (log(&e_force), log(&e_impulse), log(&e_wear));
-    let path = root.join("docs/figures/mode_convergence.png");
+    let dir = std::env::args_os().nth(1).map_or_else(
+        || std::path::PathBuf::from("fretdyn_results/mode_convergence"),
+        std::path::PathBuf::from,
+    );
+    std::fs::create_dir_all(&dir).expect("output folder");
+    let path = dir.join("mode_convergence.png");
     plot::line_plot(
         &path,
         "Tube with one mid-span support: error against the all-mode (114) solution",

@@ -609,10 +609,10 @@ impl LifeTable {
         };
         let mut coupled = vec![0.0; self.years.len()];
         let mut sum = 0.0;
-        for i in 1..self.years.len() {
+        for (i, se) in coupled.iter_mut().enumerate().skip(1) {
             let gained = self.depth[k][i] - self.depth[k][i - 1];
             sum += (gained * relative(i - 1)).powi(2);
-            coupled[i] = sum.sqrt();
+            *se = sum.sqrt();
         }
         // the first window's: the first row with a rate and its error
         let first = (0..self.years.len())

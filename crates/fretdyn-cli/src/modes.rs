@@ -136,6 +136,9 @@ fn plot_shapes(path: &Path, case: &Case, tube: &TubeModel, shown: usize) -> Resu
     draw_folder(dir).map(|_| ())
 }
 
+/// A translation of a mode along the tube: its name (`u_x`) and values.
+type Component<'a> = (&'a str, Vec<f64>);
+
 /// `mode_shapes.png` of the modes folder `dir`, from its [`SHAPES_FILE`]: a panel per mode,
 /// its translations normalised by the largest (a mode's scale is arbitrary), the supports as
 /// vertical lines; a component that is zero along the whole tube is left out of the legend
@@ -155,7 +158,7 @@ pub fn draw_folder(dir: &Path) -> Result<PathBuf, String> {
     let title = json["title"].as_str().unwrap_or("tube");
     let modes = json["modes"].as_array().cloned().unwrap_or_default();
     // each mode normalised by its largest translation
-    let columns: Vec<(f64, Vec<(&str, Vec<f64>)>)> = modes
+    let columns: Vec<(f64, Vec<Component>)> = modes
         .iter()
         .map(|m| {
             let parts: Vec<(&str, Vec<f64>)> = ["u_x", "u_y", "u_z"]

@@ -33,6 +33,7 @@ fn register_font() {
 }
 
 /// One curve: label, x values, y values (same length).
+#[derive(Clone)]
 pub struct Series<'a> {
     pub label: String,
     pub x: &'a [f64],
@@ -309,8 +310,9 @@ pub struct PanelRecord {
     pub y: AxisRecord,
     /// Legend entries, each drawn beside a short line of its style.
     pub keys: Vec<String>,
-    /// Curves: label, points, largest |y| (0: a line along the axis), points marked.
-    pub series: Vec<(String, usize, f64, bool)>,
+    /// Curves: label, points drawn, smallest and largest y (in the data's unit), points
+    /// marked.
+    pub series: Vec<(String, usize, f64, f64, bool)>,
     /// Reference lines: label, position, vertical (at an x) or horizontal (at a y).
     pub lines: Vec<(String, f64, bool)>,
     /// Error bars: (at, from, to), vertical (x, y₀, y₁) or horizontal (y, x₀, x₁).
@@ -350,7 +352,7 @@ impl Figure {
                 "x": axis(&p.x),
                 "y": axis(&p.y),
                 "keys": p.keys,
-                "series": p.series.iter().map(|(l, n, m, marked)| serde_json::json!({"label": l, "points": n, "max_abs_y": m, "marked": marked})).collect::<Vec<_>>(),
+                "series": p.series.iter().map(|(l, n, lo, hi, marked)| serde_json::json!({"label": l, "points": n, "min_y": lo, "max_y": hi, "marked": marked})).collect::<Vec<_>>(),
                 "lines": p.lines.iter().map(|(l, at, v)| serde_json::json!({"label": l, "at": at, "vertical": v})).collect::<Vec<_>>(),
                 "error_bars": p.error_bars.iter().map(|(at, a, b, v)| serde_json::json!({"at": at, "from": a, "to": b, "vertical": v})).collect::<Vec<_>>(),
                 "bands": p.bands.iter().map(|(l, n)| serde_json::json!({"label": l, "points": n})).collect::<Vec<_>>(),
@@ -769,14 +771,7 @@ pub fn line_plot(
 ) -> Result<(), String> {
     let panel = Panel {
         title: String::new(),
-        series: series
-            .iter()
-            .map(|s| Series {
-                label: s.label.clone(),
-                x: s.x,
-                y: s.y,
-            })
-            .collect(),
+        series: series.to_vec(),
         errors: Vec::new(),
         marks: Vec::new(),
     };
@@ -813,14 +808,7 @@ pub fn panels_plot_with_errors(
         .enumerate()
         .map(|(p, (t, series))| Panel {
             title: t.clone(),
-            series: series
-                .iter()
-                .map(|s| Series {
-                    label: s.label.clone(),
-                    x: s.x,
-                    y: s.y,
-                })
-                .collect(),
+            series: series.clone(),
             errors: errors.get(p).cloned().unwrap_or_default(),
             marks: Vec::new(),
         })
@@ -970,8 +958,8 @@ pub fn stacked(
 }
 
 /// The points of a panel's error bars: (series, x, y − e, y + e) for every point with an
-/// error.
-fn error_points(panel: &Panel) -> Vec<(usize, f64, f64, f64)> {
+/// error; on a `log` axis a bar reaching below a tenth of its point stops there.
+fn error_points(panel: &Panel, log: bool) -> Vec<(usize, f64, f64, f64)> {
     panel
         .series
         .iter()
@@ -983,7 +971,8 @@ fn error_points(panel: &Panel) -> Vec<(usize, f64, f64, f64)> {
                 .enumerate()
                 .filter_map(move |(i, (&x, &y))| {
                     let e = e.and_then(|e| e.get(i)).copied().unwrap_or(0.0);
-                    (e.is_finite() && e > 0.0 && y.is_finite()).then_some((k, x, y - e, y + e))
+                    let lo = if log { (y - e).max(0.1 * y) } else { y - e };
+                    (e.is_finite() && e > 0.0 && y.is_finite()).then_some((k, x, lo, y + e))
                 })
         })
         .collect()
@@ -999,10 +988,19 @@ fn draw_stacked(
     panels: &[Panel],
     layout: &Layout,
 ) -> DrawResult<()> {
+    let log = match layout.y_scale {
+        YScale::Log => true,
+        YScale::Linear => false,
+        YScale::Auto => spans_decades(
+            panels
+                .iter()
+                .flat_map(|p| p.series.iter().flat_map(|s| s.y.iter().copied())),
+        ),
+    };
     // every y value and error bound, per panel: the ranges, the unit, the scale
     let y_values = |p: &Panel| -> Vec<f64> {
         let mut v: Vec<f64> = p.series.iter().flat_map(|s| s.y.iter().copied()).collect();
-        for (_, _, lo, hi) in error_points(p) {
+        for (_, _, lo, hi) in error_points(p, log) {
             v.extend([lo, hi]);
         }
         for m in &p.marks {
@@ -1014,15 +1012,6 @@ fn draw_stacked(
         v
     };
     let all_y: Vec<f64> = panels.iter().flat_map(y_values).collect();
-    let log = match layout.y_scale {
-        YScale::Log => true,
-        YScale::Linear => false,
-        YScale::Auto => spans_decades(
-            panels
-                .iter()
-                .flat_map(|p| p.series.iter().flat_map(|s| s.y.iter().copied())),
-        ),
-    };
     let ty = |v: f64| if log { v.log10() } else { v };
     let y_range_of = |values: &[f64]| {
         let t: Vec<f64> = values
@@ -1118,7 +1107,7 @@ fn draw_stacked(
             AxisSpec::new(x_label, x_range.clone(), x_scale),
             AxisSpec::new(y_label, y_range.clone(), y_scale),
         )?;
-        let bars = error_points(panel);
+        let bars = error_points(panel, log);
         if layout.bands {
             for k in 0..series.len() {
                 let (colour, _) = style_of(k, series.len(), layout.dashed_last);
@@ -1148,14 +1137,15 @@ fn draw_stacked(
                 .map(|(x, y)| (x, ty(y)))
                 .collect();
             let (colour, dashed) = style_of(k, series.len(), layout.dashed_last);
-            let largest =
-                s.y.iter()
-                    .filter(|v| v.is_finite())
-                    .fold(0.0f64, |m, v| m.max(v.abs()));
+            let finite = || s.y.iter().copied().filter(|v| v.is_finite());
+            let (lo, hi) = (
+                finite().fold(f64::INFINITY, f64::min),
+                finite().fold(f64::NEG_INFINITY, f64::max),
+            );
             let marked = !dashed && points.len() <= MARKED_POINTS;
             record(|r| {
                 r.series
-                    .push((s.label.clone(), points.len(), largest, marked))
+                    .push((s.label.clone(), points.len(), lo, hi, marked))
             });
             // Width 1: plotters draws wider lines as polygons whose miter joins spike on
             // zig-zag data (an alternating force).

@@ -677,6 +677,21 @@ mod tests {
             statistic_label("normal_force_max"),
             "maximum normal force (N)"
         );
+        // a life study's percentiles: their axis has a unit
+        assert_eq!(
+            statistic_label("depth_at_target"),
+            "tube depth at the target time (m)"
+        );
+        assert_eq!(
+            statistic_label("time_to_criterion_fixed_gap"),
+            "time to the plugging criterion, fixed gap (years)"
+        );
+        for s in fretdyn::apps::study::LIFE_COLUMNS {
+            assert!(
+                known_statistic(s).is_some_and(|(_, u)| !u.is_empty()),
+                "{s}"
+            );
+        }
         // every statistic of the table has a readable name
         for s in fretdyn::apps::study::TABLE_STATISTICS {
             assert!(known_statistic(s).is_some(), "{s}");
