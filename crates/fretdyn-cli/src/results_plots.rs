@@ -502,6 +502,7 @@ pub fn plot_folder(dir: &Path, y_scale: YScale) -> Result<Vec<PathBuf>, Failure>
 fn plot_study(dir: &Path, y_scale: YScale) -> Result<Vec<PathBuf>, Failure> {
     use crate::sweep::{FIGURES_FILE, plot_percentiles, plot_table};
     let table = dir.join("study.csv");
+    // a folder of a fretdyn before FIGURES_FILE: Null, the study.png of its first parameter
     let figures: Value = std::fs::read_to_string(dir.join(FIGURES_FILE))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok())
@@ -526,19 +527,24 @@ fn plot_study(dir: &Path, y_scale: YScale) -> Result<Vec<PathBuf>, Failure> {
         |statistic: &str| header.iter().any(|h| h.ends_with(&format!(".{statistic}")));
     let mut written = Vec::new();
     let study = &figures["study"];
-    let (x, statistic, labels) = if study.is_object() {
-        (
-            study["x"].as_str().unwrap_or_default().to_string(),
-            study["statistic"].as_str().unwrap_or_default().to_string(),
-            study["labels"]
-                .as_array()
-                .map(|a| {
-                    a.iter()
-                        .filter_map(|v| v.as_str().map(str::to_string))
-                        .collect()
-                })
-                .unwrap_or_default(),
-        )
+    let (x, statistic, labels) = if !figures.is_null() {
+        // sweep drew study.png only when the study has a [plot]
+        if !study.is_object() {
+            (String::new(), String::new(), Vec::new())
+        } else {
+            (
+                study["x"].as_str().unwrap_or_default().to_string(),
+                study["statistic"].as_str().unwrap_or_default().to_string(),
+                study["labels"]
+                    .as_array()
+                    .map(|a| {
+                        a.iter()
+                            .filter_map(|v| v.as_str().map(str::to_string))
+                            .collect()
+                    })
+                    .unwrap_or_default(),
+            )
+        }
     } else {
         (
             header[1].clone(),
@@ -546,7 +552,7 @@ fn plot_study(dir: &Path, y_scale: YScale) -> Result<Vec<PathBuf>, Failure> {
             header[1..status].to_vec(),
         )
     };
-    if per_contact(&statistic) && header.contains(&x) {
+    if !statistic.is_empty() && per_contact(&statistic) && header.contains(&x) {
         let path = dir.join("study.png");
         plot_table(&table, &x, &statistic, &labels, y_scale, &path)?;
         written.push(path);
