@@ -163,6 +163,13 @@ class LifeResult:
         Windows of vibration simulated.
     wall_time : float
         Wall-clock time of the life, s.
+
+    Examples
+    --------
+    >>> r = fretdyn.life("examples/tube_multispan_life.toml", halvings=1)
+    >>> r.summary.loc["plate3", ["tube_depth", "tube_depth_se", "years_to_criterion"]]
+    >>> r.depths.pivot(index="time_years", columns="contact", values="tube_depth")
+    >>> r.convergence
     """
 
     def __init__(self, life_json: dict, refined: list, case: Any, max_depth_change: float):
@@ -258,13 +265,39 @@ class LifeResult:
         return pd.DataFrame(rows)
 
     def to_json(self) -> dict:
-        """The content of ``life.json`` (``criterion_depth``, ``results``), as the CLI
-        writes it."""
+        """The content of ``life.json``, as the CLI writes it.
+
+        Returns
+        -------
+        dict
+            ``criterion_depth`` (m or None) and ``results`` (contacts, clearances, steps,
+            times to the criterion in s, scars, end, windows, wall_time).
+
+        Examples
+        --------
+        >>> r.to_json()["results"]["end"]
+        {'status': 'completed'}
+        """
         return json.loads(json.dumps(self._json))
 
     def write(self, folder: PathLike) -> None:
         """Writes ``life.csv``, ``scars.csv`` (and ``convergence.csv`` with halvings) into
-        `folder`, with the columns of ``fretdyn life``'s (numbers written to round-trip)."""
+        `folder`, with the columns of ``fretdyn life``'s (numbers written to round-trip).
+        `fretdyn.life` calls it with its `output`.
+
+        Parameters
+        ----------
+        folder : str or os.PathLike
+            The folder (made if needed).
+
+        Returns
+        -------
+        None
+
+        Examples
+        --------
+        >>> r.write("my_life")
+        """
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         self.table.to_csv(folder / "life.csv", index=False, float_format="%.17g")
@@ -276,11 +309,17 @@ class LifeResult:
     def to_xarray(self):
         """The life as an xarray Dataset: dimensions ``time`` (service time, years) and
         ``contact`` (names); every column of `depths` a variable with ``units`` and
-        ``long_name``; ``criterion_depth`` (m) and ``years_to_criterion`` per contact.
+        ``long_name``; ``years_to_criterion`` per contact; the attributes ``title``,
+        ``criterion_depth`` (m) and ``life_end``.
 
         Returns
         -------
         xarray.Dataset
+
+        Examples
+        --------
+        >>> ds = r.to_xarray()
+        >>> ds.tube_depth.sel(contact="plate3").plot()
         """
         try:
             import xarray as xr
@@ -434,6 +473,12 @@ class ModesResult:
         For a tube: the abscissae of the nodes with a restrained translation, m.
     orthonormality_error : float or None
         For a tube: max |ΦᵀMΦ − I| of the finite-element modes.
+
+    Examples
+    --------
+    >>> m = fretdyn.modes("examples/tube_clamped_one_support.toml")
+    >>> m.frequencies.head()
+    >>> m.shapes[m.shapes["mode"] == 1].plot(x="s", y="u_z")
     """
 
     def __init__(self, native: dict, case: Any):
@@ -484,6 +529,11 @@ class ModesResult:
         Returns
         -------
         xarray.Dataset
+
+        Examples
+        --------
+        >>> ds = m.to_xarray()
+        >>> ds.frequency.sel(mode=1).item()
         """
         try:
             import xarray as xr
