@@ -270,3 +270,39 @@ def test_modes_of_a_modal_basis_have_no_tube_shapes():
     assert m.shapes is None and m.supports is None
     assert same(m.frequencies["frequency_hz"],
                 fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml").frequencies_hz)
+
+
+def test_a_life_stopped_by_ctrl_c_resumes_to_the_depths_of_an_uninterrupted_one(tmp_path):
+    """A life in a Python process, Ctrl-C (SIGINT) once its first checkpoint is written: it
+    stops with KeyboardInterrupt and leaves its checkpoint; resumed, its depths are those of
+    the life never stopped, bit for bit. Windows of 1.5 s, so that the signal
+    comes inside the life."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    text = (EXAMPLES / "tube_multispan_life.toml").read_text()
+    path = tmp_path / "case.toml"
+    path.write_text(text.replace("duration = 2.0", "duration = 1.5"))
+    out = tmp_path / "out"
+    script = ("import sys, fretdyn\n"
+              "fretdyn.life(sys.argv[1], years=10.0, output=sys.argv[2], checkpoint_every=0.0)\n")
+    child = subprocess.Popen([sys.executable, "-c", script, str(path), str(out)],
+                             stderr=subprocess.PIPE, text=True)
+    checkpoint = out / "life_checkpoint.bin"
+    deadline = time.time() + 120
+    while not checkpoint.exists() and child.poll() is None and time.time() < deadline:
+        time.sleep(0.02)
+    assert checkpoint.exists(), "no checkpoint before the life ended"
+    child.send_signal(signal.SIGINT)
+    _, stderr = child.communicate(timeout=120)
+    assert child.returncode != 0 and "KeyboardInterrupt" in stderr, stderr
+    assert checkpoint.exists()
+    assert json.loads((out / "life.json").read_text())["results"]["end"]["status"] == "stopped"
+    resumed = fretdyn.life(path, years=10.0, output=out, resume=True)
+    whole = fretdyn.life(path, years=10.0)
+    assert resumed.end == whole.end == {"status": "completed"}
+    for column in whole.table.columns:
+        assert same(resumed.table[column], whole.table[column]), column
+    assert not checkpoint.exists()
