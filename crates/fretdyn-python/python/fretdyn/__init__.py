@@ -982,8 +982,8 @@ def percentiles(
     -------
     pandas.DataFrame, numpy structured array or None
         One row per group, column and level, the columns of ``percentiles.csv``: the grid
-        parameters that define the group (typed as in the study table: float64, int64 for
-        ``run``/``sample``/``seed``), then ``column``, ``level``, ``n``, ``excluded``
+        parameters that define the group (typed as `read_table` types the study table:
+        float64, int64 for ``seed``), then ``column``, ``level``, ``n``, ``excluded``
         (int64), ``estimate``, ``ci_low``, ``ci_high``, ``ci_coverage``, ``bootstrap_se``
         (NaN for what too few samples cannot give: a bound, the bootstrap error of fewer
         than 2 values, the estimate of none). A DataFrame (like `sweep`'s) whose ``attrs``
@@ -1022,13 +1022,14 @@ def percentiles(
 
 def _typed(name: str, cells: List[str]) -> Union[np.ndarray, List[str]]:
     """A column of a study's table from its cells: numbers as float64 (NaN where empty),
-    the indices ``run``, ``sample`` and ``seed`` as int64 when every cell is an integer;
-    text (a column with a cell that is not a number) as a list of str."""
+    the counts ``run``, ``sample``, ``seed`` (a study's table), ``level``, ``n`` and
+    ``excluded`` (``percentiles.csv``) as int64 when every cell is an integer; text (a
+    column with a cell that is not a number) as a list of str."""
     try:
         numbers = np.array([float(v) if v else np.nan for v in cells])
     except ValueError:
         return list(cells)
-    if name in _INDEX_COLUMNS and all(v.isdigit() for v in cells):
+    if name in _INTEGER_COLUMNS and all(v.isdigit() for v in cells):
         return np.array([int(v) for v in cells], dtype=np.int64)
     return numbers
 
@@ -1046,8 +1047,9 @@ def read_table(table: PathLike) -> dict:
     -------
     dict
         Column name → numpy array of floats (numbers; NaN where empty) or list of str (text),
-        complete rows only, in the order of the file. The indices ``run``, ``sample`` and
-        ``seed`` are arrays of int64 when every row has one.
+        complete rows only, in the order of the file. The counts ``run``, ``sample`` and
+        ``seed`` (of ``study.csv``), ``level``, ``n`` and ``excluded`` (of
+        ``percentiles.csv``) are arrays of int64 when every row has one.
 
     Examples
     --------
@@ -1060,8 +1062,9 @@ def read_table(table: PathLike) -> dict:
     return {name: _typed(name, [r[k] for r in body]) for k, name in enumerate(header)}
 
 
-# the columns of a study's table that count runs, samples and seeds: integers
-_INDEX_COLUMNS = ("run", "sample", "seed")
+# the columns of a study's table that count runs, samples and seeds, and those of
+# percentiles.csv that count levels and values: integers
+_INTEGER_COLUMNS = ("run", "sample", "seed", "level", "n", "excluded")
 
 
 from ._life import LifeResult, ModesResult, life, modes  # noqa: E402
