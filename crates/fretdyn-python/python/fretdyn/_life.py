@@ -282,7 +282,8 @@ class LifeResult:
 
     def write(self, folder: PathLike) -> None:
         """Writes ``life.csv``, ``scars.csv`` (and ``convergence.csv`` with halvings) into
-        `folder`, with the columns of ``fretdyn life``'s (numbers written to round-trip).
+        `folder`, with the columns of ``fretdyn life``'s (numbers written to read back exactly,
+        an empty cell for a missing value).
         `fretdyn.life` calls it with its `output`.
 
         Parameters
@@ -300,11 +301,12 @@ class LifeResult:
         """
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
-        self.table.to_csv(folder / "life.csv", index=False, float_format="%.17g")
-        self.scars.to_csv(folder / "scars.csv", index=False, float_format="%.17g")
+        # pandas writes a float as Python's repr, the shortest text that reads back the
+        # same number, and NaN as an empty cell: the CLI's conventions
+        self.table.to_csv(folder / "life.csv", index=False)
+        self.scars.to_csv(folder / "scars.csv", index=False)
         if self.convergence is not None:
-            self.convergence.to_csv(folder / "convergence.csv", index=False,
-                                    float_format="%.17g")
+            self.convergence.to_csv(folder / "convergence.csv", index=False)
 
     def to_xarray(self):
         """The life as an xarray Dataset: dimensions ``time`` (service time, years) and
