@@ -401,7 +401,8 @@ def life(
         Its ``depths`` (a DataFrame: depth per contact and life step with its standard
         error), ``summary`` (by contact: the final depths, the plugging criterion, the years
         to reach it), ``scars``, ``convergence``, ``table`` (``life.csv``), ``to_xarray()``;
-        plots: `fretdyn.plot.life`.
+        plots: `fretdyn.plot.life`. Its tables are pandas DataFrames: pandas is needed
+        (``pip install fretdyn[pandas]``; an ImportError says so).
 
     Raises
     ------
@@ -586,7 +587,7 @@ def modes(case: Any, output: Optional[PathLike] = None) -> ModesResult:
     -------
     ModesResult
         ``frequencies`` (a DataFrame by mode), ``points``, ``shapes`` (a tube's),
-        ``to_xarray()``; plots: `fretdyn.plot.modes`.
+        ``to_xarray()``; plots: `fretdyn.plot.modes`. pandas is needed.
 
     Examples
     --------
