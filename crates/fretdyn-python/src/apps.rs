@@ -75,8 +75,9 @@ fn fingerprint(case: &Case) -> PyResult<u64> {
 }
 
 /// A new life in `dir`: the folder made, the files of an earlier life there removed, and the
-/// fingerprint of its inputs recorded (`life_run.json`).
-fn start_afresh(dir: &Path, fingerprint: u64) -> PyResult<()> {
+/// fingerprint of its inputs recorded (`life_run.json`), with the case file when the case is
+/// one as it is on disk (then `fretdyn life --resume DIR` continues it too).
+fn start_afresh(dir: &Path, fingerprint: u64, case_file: Option<&Path>) -> PyResult<()> {
     std::fs::create_dir_all(dir).map_err(|e| {
         FretdynError::new_err(format!("{}: cannot create the folder: {e}", dir.display()))
     })?;
@@ -89,7 +90,11 @@ fn start_afresh(dir: &Path, fingerprint: u64) -> PyResult<()> {
             _ => {}
         }
     }
-    let info = serde_json::json!({ "fingerprint": fingerprint.to_string() });
+    let mut info = serde_json::json!({ "fingerprint": fingerprint.to_string() });
+    if let Some(path) = case_file {
+        let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        info["case_file"] = serde_json::json!(absolute);
+    }
     fretdyn::files::write_text_atomically(&dir.join(LIFE_RUN_FILE), &format!("{info:#}\n"))
         .map_err(err)
 }
@@ -141,9 +146,11 @@ fn life_json(r: &LifeResults, criterion: Option<f64>) -> String {
 /// times: `(max_depth_change, JSON of their results)` each (the convergence check of
 /// `--halvings`). With `output` (a folder): the life's checkpoint (after every life step and
 /// every `checkpoint_every` s inside a window), `life_run.json` and `life.json` are written
-/// there, and `resume` continues the life stopped there.
+/// there, and `resume` continues the life stopped there (one the CLI started too: the same
+/// fingerprint); `case_file`, the file the case was read from unchanged, is recorded for
+/// `fretdyn life --resume`.
 #[pyfunction]
-#[pyo3(signature = (case, halvings = 0, output = None, resume = false, checkpoint_every = 60.0))]
+#[pyo3(signature = (case, halvings = 0, output = None, resume = false, checkpoint_every = 60.0, case_file = None))]
 pub(crate) fn life(
     py: Python<'_>,
     case: &Case,
@@ -151,6 +158,7 @@ pub(crate) fn life(
     output: Option<PathBuf>,
     resume: bool,
     checkpoint_every: f64,
+    case_file: Option<PathBuf>,
 ) -> PyResult<(String, Vec<(f64, String)>)> {
     let c = &case.inner;
     let Some(settings) = c.life.clone() else {
@@ -163,9 +171,10 @@ pub(crate) fn life(
             "halvings: at most {MAX_HALVINGS} (each about doubles the life steps), got {halvings}"
         )));
     }
-    if !(checkpoint_every.is_finite() && checkpoint_every >= 0.0) {
+    if !(checkpoint_every.is_finite() && checkpoint_every > 0.0) {
+        // the CLI's message for --checkpoint-every
         return Err(FretdynError::new_err(format!(
-            "checkpoint_every: must be wall-clock seconds ≥ 0 (got {checkpoint_every})"
+            "checkpoint_every: must be a positive number of seconds (got {checkpoint_every})"
         )));
     }
     // a case that cannot have a life, or cannot start its first window, is refused before
@@ -179,7 +188,7 @@ pub(crate) fn life(
     let resumed = match (&output, resume) {
         (Some(dir), true) => Some(read_checkpoint(dir, fingerprint)?),
         (Some(dir), false) => {
-            start_afresh(dir, fingerprint)?;
+            start_afresh(dir, fingerprint, case_file.as_deref())?;
             None
         }
         (None, true) => {

@@ -12,7 +12,7 @@ import pytest
 
 import fretdyn
 
-from helpers import EXAMPLES, cli
+from helpers import EXAMPLES, FRETDYN, cli
 
 pd = pytest.importorskip("pandas")
 
@@ -157,6 +157,8 @@ def test_bad_lives_are_the_clis_messages(tmp_path):
         "life.max_depth_change: must be a fraction in (0, 1] (got 2)")
     assert message(years=-1.0) == "life.target_years: must be a service time > 0 in years"
     assert message(halvings=11).startswith("halvings: at most 10")
+    assert message(checkpoint_every=0.0) == (
+        "checkpoint_every: must be a positive number of seconds (got 0)")
     assert message(resume=True).startswith("resume: give the folder of the life to continue")
     assert "no checkpoint to resume" in message(output=tmp_path / "none", resume=True) or \
         "changed since the life" in message(output=tmp_path / "none", resume=True)
@@ -272,24 +274,19 @@ def test_modes_of_a_modal_basis_have_no_tube_shapes():
                 fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml").frequencies_hz)
 
 
-def test_a_life_stopped_by_ctrl_c_resumes_to_the_depths_of_an_uninterrupted_one(tmp_path):
-    """A life in a Python process, Ctrl-C (SIGINT) once its first checkpoint is written: it
-    stops with KeyboardInterrupt and leaves its checkpoint; resumed, its depths are those of
-    the life never stopped, bit for bit. Windows of 1.5 s, so that the signal
-    comes inside the life."""
+def stopped_life(path, out, by_cli=False):
+    """A life of the case file `path` run by Python (or the CLI) into `out`, stopped by
+    Ctrl-C (SIGINT) once its first checkpoint is written: it stops (KeyboardInterrupt) and
+    leaves its checkpoint."""
     import signal
     import subprocess
     import sys
     import time
 
-    text = (EXAMPLES / "tube_multispan_life.toml").read_text()
-    path = tmp_path / "case.toml"
-    path.write_text(text.replace("duration = 2.0", "duration = 1.5"))
-    out = tmp_path / "out"
-    script = ("import sys, fretdyn\n"
-              "fretdyn.life(sys.argv[1], years=10.0, output=sys.argv[2], checkpoint_every=0.0)\n")
-    child = subprocess.Popen([sys.executable, "-c", script, str(path), str(out)],
-                             stderr=subprocess.PIPE, text=True)
+    script = "import sys, fretdyn\nfretdyn.life(sys.argv[1], output=sys.argv[2], checkpoint_every=0.001)\n"
+    command = ([FRETDYN, "life", str(path), "-o", str(out), "--no-plots", "--checkpoint-every", "0.001"]
+               if by_cli else [sys.executable, "-c", script, str(path), str(out)])
+    child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     checkpoint = out / "life_checkpoint.bin"
     deadline = time.time() + 120
     while not checkpoint.exists() and child.poll() is None and time.time() < deadline:
@@ -297,12 +294,36 @@ def test_a_life_stopped_by_ctrl_c_resumes_to_the_depths_of_an_uninterrupted_one(
     assert checkpoint.exists(), "no checkpoint before the life ended"
     child.send_signal(signal.SIGINT)
     _, stderr = child.communicate(timeout=120)
-    assert child.returncode != 0 and "KeyboardInterrupt" in stderr, stderr
+    assert child.returncode != 0 and ("interrupted" if by_cli else "KeyboardInterrupt") in stderr, stderr
     assert checkpoint.exists()
     assert json.loads((out / "life.json").read_text())["results"]["end"]["status"] == "stopped"
-    resumed = fretdyn.life(path, years=10.0, output=out, resume=True)
-    whole = fretdyn.life(path, years=10.0)
-    assert resumed.end == whole.end == {"status": "completed"}
+
+
+def test_a_life_stopped_by_ctrl_c_resumes_to_the_depths_of_an_uninterrupted_one(tmp_path):
+    """Stopped by Python and resumed by Python; stopped by Python and resumed by ``fretdyn
+    life --resume`` (the folder records the case file); stopped by the CLI and resumed by
+    Python (the same fingerprint of the inputs): each gives the depths of the life never
+    stopped, bit for bit.
+    Windows of 1.5 s, 10 years, so that the signal comes inside the life."""
+    text = (EXAMPLES / "tube_multispan_life.toml").read_text()
+    path = tmp_path / "case.toml"
+    path.write_text(text.replace("duration = 2.0", "duration = 1.5").replace(
+        "target_years = 40.0", "target_years = 10.0"))
+    whole = fretdyn.life(path)
+    assert whole.end == {"status": "completed"}
+    stopped_life(path, tmp_path / "py")
+    resumed = fretdyn.life(path, output=tmp_path / "py", resume=True)
+    assert resumed.end == {"status": "completed"}
     for column in whole.table.columns:
         assert same(resumed.table[column], whole.table[column]), column
-    assert not checkpoint.exists()
+    assert not (tmp_path / "py" / "life_checkpoint.bin").exists()
+    stopped_life(path, tmp_path / "cli")
+    out = cli(["life", "--resume", "cli", "--no-plots"], tmp_path)
+    assert out.returncode == 0, out.stderr
+    table = cli_csv(tmp_path / "cli" / "life.csv")
+    for column in table:
+        assert same(whole.table[column], table[column]), column
+    stopped_life(path, tmp_path / "from_cli", by_cli=True)
+    resumed = fretdyn.life(path, output=tmp_path / "from_cli", resume=True)
+    for column in whole.table.columns:
+        assert same(resumed.table[column], whole.table[column]), column

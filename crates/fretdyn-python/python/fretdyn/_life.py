@@ -390,10 +390,12 @@ def life(
         there removes the files of an earlier one.
     resume : bool, default False
         Continue the life stopped (Ctrl-C, killed) in `output` from its checkpoint
-        (``--resume``); refused when the case changed since.
+        (``--resume``); refused when the case changed since. A life ``fretdyn life``
+        started is continued too, and ``fretdyn life --resume DIR`` continues one started
+        here from a case file without `years` or `max_depth_change`.
     checkpoint_every : float, default 60
-        Wall-clock seconds between checkpoints inside a window (with `output`;
-        ``--checkpoint-every``).
+        Wall-clock seconds (> 0) between checkpoints inside a window (with `output`;
+        ``--checkpoint-every``); one is written after every life step too.
 
     Returns
     -------
@@ -421,6 +423,7 @@ def life(
     """
     from . import _case
 
+    case_file = os.fspath(case) if isinstance(case, (str, os.PathLike)) else None
     case = _case(case, "life")
     changes = {}
     if years is not None:
@@ -429,11 +432,12 @@ def life(
         changes["life.max_depth_change"] = max_depth_change
     if changes and "life" in case.to_dict():
         case = case.with_(changes)
+        case_file = None  # not the file's case any more
     if isinstance(halvings, bool) or not isinstance(halvings, (int, np.integer)) or halvings < 0:
         raise FretdynError(f"halvings: a number of halvings ≥ 0 (at most 10), got {halvings!r}")
     life_json, refined = _native.life(
         case._native, int(halvings), None if output is None else os.fspath(output),
-        bool(resume), float(checkpoint_every),
+        bool(resume), float(checkpoint_every), case_file,
     )
     data = json.loads(life_json)
     settings = case.to_dict().get("life", {})
