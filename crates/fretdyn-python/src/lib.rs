@@ -13,6 +13,7 @@ use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+mod apps;
 mod dict_case;
 use dict_case::Document;
 
@@ -822,6 +823,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RESULTS_COMMENT", fretdyn::results::variables::COMMENT)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
+    m.add_function(wrap_pyfunction!(apps::life, m)?)?;
+    m.add_function(wrap_pyfunction!(apps::modes, m)?)?;
     m.add_function(wrap_pyfunction!(study_runs, m)?)?;
     m.add_function(wrap_pyfunction!(study_header, m)?)?;
     m.add_function(wrap_pyfunction!(study_row, m)?)?;

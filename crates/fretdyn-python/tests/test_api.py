@@ -89,14 +89,17 @@ def test_the_contacts_table_is_the_summary_flattened(tube_run, tmp_path):
     t = r.contacts
     assert isinstance(t, pd.DataFrame)
     assert list(t["name"]) == r.contact_names and t.columns[0] == "name"
+    # indexed by the contact's name
+    assert list(t.index) == r.contact_names and t.index.name == "contact"
+    assert t.loc[r.contact_names[1], "wear_work_rate"] == r.summary["contacts"][1]["wear_work_rate"]
     for k, c in enumerate(r.summary["contacts"]):
         for key, value in c.items():
             if isinstance(value, (list, dict)):
                 assert key not in t.columns
             elif isinstance(value, str):
-                assert t[key][k] == value
+                assert t[key].iloc[k] == value
             else:
-                assert t[key][k] == value, key
+                assert t[key].iloc[k] == value, key
     # with the CLI's contacts.csv (when it writes one): the same values in the same columns
     csv = out / "contacts.csv"
     if csv.exists():
@@ -592,7 +595,7 @@ def test_a_dict_study_on_a_dask_cluster_equals_the_local_one(tmp_path):
 
 
 def test_a_probabilistic_dict_study_gives_its_percentiles(tmp_path):
-    pytest.importorskip("pandas")
+    pd = pytest.importorskip("pandas")
     case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
     study = {
         "base": case, "samples": 5, "seed": 2,
@@ -604,8 +607,46 @@ def test_a_probabilistic_dict_study_gives_its_percentiles(tmp_path):
     mu = t["contacts[0].friction.mu"].to_numpy()
     assert len(t) == 5 and np.all((mu >= 0.1) & (mu < 0.5)) and len(set(mu)) == 5
     p = fretdyn.percentiles(study, tmp_path / "p.csv")
-    (row,) = [r for r in p["rows"] if r["column"] == "plane.wear_work_rate"]
-    assert row["estimate"] == pytest.approx(np.percentile(t["plane.wear_work_rate"], 50), rel=1e-12)
+    # a DataFrame, as sweep's; its report's settings in attrs
+    assert isinstance(p, pd.DataFrame) and p.attrs["seed"] == 2
+    (estimate,) = p.loc[p["column"] == "plane.wear_work_rate", "estimate"]
+    assert estimate == pytest.approx(np.percentile(t["plane.wear_work_rate"], 50), rel=1e-12)
+    assert p["level"].dtype == np.int64 and p["n"].dtype == np.int64 and list(p["n"]) == [5]
+
+
+def test_the_groups_of_percentiles_are_numbers(tmp_path):
+    """A grid parameter (μ) beside a drawn one: the percentiles are per μ, and μ comes back
+    as a float column (it came back as the strings '0.1', '0.3')."""
+    pd = pytest.importorskip("pandas")
+    case = fretdyn.Case.from_file(EXAMPLES / "v1a_oblique_impact.toml")
+    study = {
+        "base": case, "samples": 3, "seed": 4,
+        "parameters": [
+            {"key": "contacts[0].friction.mu", "values": [0.1, 0.3]},
+            {"key": "contacts[0].obstacle.gap", "distribution":
+             {"type": "uniform", "low": 0.0, "high": 1e-6}},
+        ],
+        "percentiles": {"statistics": ["wear_work_rate"], "levels": [50]},
+    }
+    t = fretdyn.sweep(study, tmp_path / "study.csv")
+    p = fretdyn.percentiles(study, tmp_path / "study.csv", output=tmp_path)
+    assert isinstance(p, pd.DataFrame)
+    mu = "contacts[0].friction.mu"
+    assert p[mu].dtype == np.float64 and list(p[mu]) == [0.1, 0.3]
+    assert p[mu].dtype == t[mu].dtype
+    for value, estimate in zip(p[mu], p["estimate"]):
+        runs = t.loc[t[mu] == value, "plane.wear_work_rate"]
+        assert len(runs) == 3
+        assert estimate == pytest.approx(np.percentile(runs, 50), rel=1e-12)
+    # the same table as percentiles.csv
+    written = fretdyn.read_table(tmp_path / "percentiles.csv")
+    assert list(written) == list(p.columns)
+    for k in written:
+        if isinstance(written[k], list):
+            assert written[k] == list(p[k]), k
+        else:
+            assert np.array_equal(written[k], p[k].to_numpy(), equal_nan=True), k
+            assert written[k].dtype == p[k].dtype, k
 
 
 def test_what_one_sample_cannot_give_is_an_empty_cell_and_null(tmp_path):
@@ -622,17 +663,18 @@ def test_what_one_sample_cannot_give_is_an_empty_cell_and_null(tmp_path):
     p = fretdyn.percentiles(study, tmp_path / "study.csv", output=tmp_path)
     text = (tmp_path / "percentiles.csv").read_text()
     assert "nan" not in text.lower(), text
-    assert json.loads((tmp_path / "percentiles.json").read_text()) == p
+    report = json.loads((tmp_path / "percentiles.json").read_text())
     table = fretdyn.read_table(tmp_path / "percentiles.csv")
     numbers = ["estimate", "ci_low", "ci_high", "ci_coverage", "bootstrap_se"]
-    assert [r["level"] for r in p["rows"]] == [50, 95, 99]
-    for i, row in enumerate(p["rows"]):
+    assert [r["level"] for r in report["rows"]] == [50, 95, 99] == list(p["level"])
+    for i, row in enumerate(report["rows"]):
         assert row["n"] == 1 and row["ci_high"] is None and row["bootstrap_se"] is None
         for k in numbers:
-            # NaN read back exactly where the JSON has null
+            # NaN read back exactly where the JSON has null, in the file and the DataFrame
             assert np.isnan(table[k][i]) == (row[k] is None), (k, row)
+            assert np.isnan(p[k].iloc[i]) == (row[k] is None), (k, row)
             if row[k] is not None:
-                assert table[k][i] == row[k]
+                assert table[k][i] == row[k] == p[k].iloc[i]
     pd = pytest.importorskip("pandas")
     frame = pd.read_csv(tmp_path / "percentiles.csv")
     assert frame["bootstrap_se"].isna().all() and frame["estimate"].notna().all()

@@ -6,13 +6,16 @@ Coulomb friction (explicit central differences; penalty, Active Set or projected
     r = fretdyn.run(case)            # a Result: numpy arrays, GIL released, Ctrl-C honoured
     r = fretdyn.run("examples/v1a_oblique_impact.toml")   # the same, from the path
     r.contact_normal_force[:, 0], r.summary["contacts"][0]["wear_work_rate"]
-    r.impacts, r.blocks, r.contacts  # tables (pandas DataFrames when pandas is installed)
+    r.impacts, r.blocks, r.contacts  # tables (pandas DataFrames; contacts indexed by name)
     r.to_xarray()                    # an xarray.Dataset with names, dimensions and units
     fretdyn.plot.orbits(r)           # matplotlib plots for notebooks
     wider = case.with_(**{"contacts[0].obstacle.gap": 1e-4})   # a changed copy
     s = fretdyn.stability("examples/ubend_flow.toml")   # the Connors check, per mode
     table = fretdyn.sweep({"base": case, "parameters": [
         {"key": "contacts[0].friction.mu", "values": [0.1, 0.3]}]})   # a DataFrame
+    life = fretdyn.life("examples/tube_multispan_life.toml", years=5)   # the service life
+    life.summary, life.depths        # depth per contact, years to the plugging limit
+    m = fretdyn.modes("examples/tube_clamped_one_support.toml")   # frequencies, shapes
 
 Cases come from a TOML file, TOML text, or a Python dict with the structure of a case file
 (numpy arrays are accepted anywhere a list is). Studies (`sweep`) run on every core, or on a
@@ -39,7 +42,8 @@ from . import med  # modal bases from Code_Aster's MED files (docs/MED.md)
 
 __all__ = [
     "Case", "Result", "FretdynError", "run", "stability", "sweep", "percentiles",
-    "read_table", "modal_structure", "variables", "plot", "__version__",
+    "read_table", "modal_structure", "variables", "life", "modes", "LifeResult",
+    "ModesResult", "plot", "__version__",
 ]
 __version__ = _native.__version__
 
@@ -528,7 +532,7 @@ class Result(Mapping):
     >>> r = fretdyn.run("examples/v1a_oblique_impact.toml")
     >>> r.t.shape, r.contact_normal_force.shape
     ((4001,), (4001, 1))
-    >>> r.summary["contacts"][0]["wear_work_rate"] == r.contacts["wear_work_rate"][0]
+    >>> r.summary["contacts"][0]["wear_work_rate"] == r.contacts.loc["plane", "wear_work_rate"]
     True
     """
 
@@ -652,7 +656,9 @@ class Result(Mapping):
 
         The columns are the keys of ``summary["contacts"]`` (``name`` first; nested keys
         joined by dots; the peak force histogram left out), as in ``contacts.csv``: a pandas
-        DataFrame when pandas is installed, else a numpy structured array.
+        DataFrame indexed by the contact's name (``r.contacts.loc["plate3",
+        "wear_work_rate"]``; the index is named ``contact``) when pandas is installed, else
+        a numpy structured array.
         """
         rows = [_flatten(c) for c in self._summary["contacts"]]
         keys: List[str] = ["name"]
@@ -665,7 +671,10 @@ class Result(Mapping):
                 columns[k] = np.array(values, dtype=str)
             else:
                 columns[k] = np.array([np.nan if v is None else v for v in values])
-        return _table(columns)
+        out = _table(columns)
+        if hasattr(out, "set_index"):
+            out.index = _pandas().Index(columns["name"], name="contact")
+        return out
 
     def to_xarray(self):
         """The time histories as an xarray Dataset with names and units: the Dataset
@@ -949,9 +958,9 @@ def percentiles(
     table: PathLike,
     output: Optional[PathLike] = None,
     base_dir: Optional[PathLike] = None,
-) -> Optional[dict]:
+):
     """The percentiles of a study's statistics across its samples, as ``fretdyn sweep``
-    writes them in ``percentiles.json`` (docs/STUDIES.md).
+    writes them in ``percentiles.csv`` and ``percentiles.json`` (docs/STUDIES.md).
 
     The interval is distribution-free (order statistics); a table written on a Dask cluster
     gives the same report as one written locally.
@@ -971,24 +980,58 @@ def percentiles(
 
     Returns
     -------
-    dict or None
-        ``{"confidence", "bootstrap_resamples", "seed", "rows": [{"group", "column",
-        "level", "n", "excluded", "estimate", "ci_low", "ci_high", "ci_coverage",
-        "bootstrap_se"}, ...]}`` (P50, P95, P99 by default; ``None`` for what too few
-        samples cannot give: a bound, the bootstrap error of fewer than 2 values, the
-        estimate of none); ``None`` when the study asks for no percentiles (no ``samples``,
+    pandas.DataFrame, numpy structured array or None
+        One row per group, column and level, the columns of ``percentiles.csv``: the grid
+        parameters that define the group (typed as `read_table` types the study table:
+        float64, int64 for ``seed``), then ``column``, ``level``, ``n``, ``excluded``
+        (int64), ``estimate``, ``ci_low``, ``ci_high``, ``ci_coverage``, ``bootstrap_se``
+        (NaN for what too few samples cannot give: a bound, the bootstrap error of fewer
+        than 2 values, the estimate of none). A DataFrame (like `sweep`'s) whose ``attrs``
+        hold ``confidence``, ``bootstrap_resamples`` and ``seed``; without pandas a
+        structured array. ``None`` when the study asks for no percentiles (no ``samples``,
         no ``[percentiles]``).
 
     Examples
     --------
     >>> p = fretdyn.percentiles("examples/study_clearance_probabilistic.toml", "study.csv")
-    >>> [(r["column"], r["level"], r["estimate"]) for r in p["rows"]]
+    >>> p[["column", "level", "estimate", "ci_low", "ci_high"]]
+    >>> p.set_index(["column", "level"]).loc[("plate3.wear_work_rate", 95), "estimate"]
     """
     out = _native.study_percentiles(
         _study_source(study, base_dir), os.fspath(table),
         None if output is None else os.fspath(output),
     )
-    return None if out is None else json.loads(out)
+    if out is None:
+        return None
+    report = json.loads(out)
+    rows = report["rows"]
+    groups: List[str] = []
+    for r in rows:
+        groups += [k for k in r["group"] if k not in groups]
+    columns: dict = {k: _typed(k, [r["group"].get(k, "") for r in rows]) for k in groups}
+    columns["column"] = np.array([r["column"] for r in rows], dtype=str)
+    for k in ("level", "n", "excluded"):
+        columns[k] = np.array([r[k] for r in rows], dtype=np.int64)
+    for k in ("estimate", "ci_low", "ci_high", "ci_coverage", "bootstrap_se"):
+        columns[k] = np.array([np.nan if r[k] is None else r[k] for r in rows], dtype=float)
+    frame = _table(columns)
+    if hasattr(frame, "attrs"):
+        frame.attrs.update({k: v for k, v in report.items() if k != "rows"})
+    return frame
+
+
+def _typed(name: str, cells: List[str]) -> Union[np.ndarray, List[str]]:
+    """A column of a study's table from its cells: numbers as float64 (NaN where empty),
+    the counts ``run``, ``sample``, ``seed`` (a study's table), ``level``, ``n`` and
+    ``excluded`` (``percentiles.csv``) as int64 when every cell is an integer; text (a
+    column with a cell that is not a number) as a list of str."""
+    try:
+        numbers = np.array([float(v) if v else np.nan for v in cells])
+    except ValueError:
+        return list(cells)
+    if name in _INTEGER_COLUMNS and all(v.isdigit() for v in cells):
+        return np.array([int(v) for v in cells], dtype=np.int64)
+    return numbers
 
 
 def read_table(table: PathLike) -> dict:
@@ -1004,8 +1047,9 @@ def read_table(table: PathLike) -> dict:
     -------
     dict
         Column name → numpy array of floats (numbers; NaN where empty) or list of str (text),
-        complete rows only, in the order of the file. The indices ``run``, ``sample`` and
-        ``seed`` are arrays of int64 when every row has one.
+        complete rows only, in the order of the file. The counts ``run``, ``sample`` and
+        ``seed`` (of ``study.csv``), ``level``, ``n`` and ``excluded`` (of
+        ``percentiles.csv``) are arrays of int64 when every row has one.
 
     Examples
     --------
@@ -1015,21 +1059,13 @@ def read_table(table: PathLike) -> dict:
     with open(table, newline="") as f:
         rows = list(csv.reader(f))
     header, body = rows[0], [r for r in rows[1:] if len(r) == len(rows[0])]
-    out: dict = {}
-    for k, name in enumerate(header):
-        col = [r[k] for r in body]
-        try:
-            out[name] = np.array([float(v) if v else np.nan for v in col])
-        except ValueError:
-            out[name] = col
-            continue
-        if name in _INDEX_COLUMNS and all(v.isdigit() for v in col):
-            out[name] = np.array([int(v) for v in col], dtype=np.int64)
-    return out
+    return {name: _typed(name, [r[k] for r in body]) for k, name in enumerate(header)}
 
 
-# the columns of a study's table that count runs, samples and seeds: integers
-_INDEX_COLUMNS = ("run", "sample", "seed")
+# the columns of a study's table that count runs, samples and seeds, and those of
+# percentiles.csv that count levels and values: integers
+_INTEGER_COLUMNS = ("run", "sample", "seed", "level", "n", "excluded")
 
 
+from ._life import LifeResult, ModesResult, life, modes  # noqa: E402
 from . import plot  # noqa: E402  (matplotlib is imported when a plot is drawn)

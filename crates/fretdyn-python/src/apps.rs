@@ -1,0 +1,366 @@
+//! The service life and the modal basis of a case for Python (`fretdyn.life`, `fretdyn.modes`),
+//! computed by the library as `fretdyn life` and `fretdyn modes` compute them: the life with
+//! the GIL released and Ctrl-C honoured (the life stops after a checkpoint, as the CLI's), its
+//! checkpoint and `life.json` in an output folder for a later `resume`; the basis as numpy
+//! arrays. The tables and the messages of how a life ended are built in Python
+//! (`python/fretdyn/_life.py`).
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use fretdyn::apps::life::{LifeCheckpoint, LifeControl, LifeResults, LifeSettings};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::{Case, FretdynError, err};
+
+/// The file that records the inputs of a life's folder, for `resume` (the CLI's name).
+const LIFE_RUN_FILE: &str = "life_run.json";
+
+/// The checkpoint of a life (the CLI's name).
+const CHECKPOINT_FILE: &str = "life_checkpoint.bin";
+
+/// What a life writes in its folder: removed when a new life starts there, so that a folder
+/// never mixes two lives (the CLI's list; `life.csv`, `scars.csv`, `convergence.csv` are
+/// written by the Python package).
+const OUTPUTS: [&str; 6] = [
+    "life.csv",
+    "life.json",
+    "scars.csv",
+    "life.png",
+    "convergence.csv",
+    "convergence.png",
+];
+
+/// Most halvings of `halvings` (`fretdyn life --halvings`: each about doubles the life steps).
+const MAX_HALVINGS: u32 = 10;
+
+/// Runs `work` on a thread of its own while this thread waits with the GIL released and looks
+/// for Ctrl-C every 50 ms: on Ctrl-C (or any pending signal's exception) `work`'s stop flag
+/// is set, `work` is waited for (it stops at its next batch of steps) and the exception comes
+/// back beside its result.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce(&AtomicBool) -> T + Send,
+) -> (T, Option<PyErr>) {
+    let stop = AtomicBool::new(false);
+    let mut interrupted = None;
+    let out = std::thread::scope(|s| {
+        let handle = s.spawn(|| work(&stop));
+        while !handle.is_finished() {
+            py.detach(|| std::thread::sleep(Duration::from_millis(50)));
+            if interrupted.is_none()
+                && let Err(e) = py.check_signals()
+            {
+                interrupted = Some(e);
+                stop.store(true, Ordering::Relaxed);
+            }
+        }
+        handle.join()
+    });
+    match out {
+        Ok(out) => (out, interrupted),
+        Err(panic) => std::panic::resume_unwind(panic),
+    }
+}
+
+/// The fingerprint of a case's inputs (its TOML as read, the `[life]` settings included, and
+/// the files it reads), as `fretdyn life` takes it of its case file.
+fn fingerprint(case: &Case) -> PyResult<u64> {
+    let value = toml::Value::try_from(&case.inner.echo)
+        .map_err(|e| FretdynError::new_err(format!("the case cannot be fingerprinted: {e}")))?;
+    Ok(fretdyn::case::fingerprint::Fingerprint::of(&value, &case.base_dir).value())
+}
+
+/// A new life in `dir`: the folder made, the files of an earlier life there removed, and the
+/// fingerprint of its inputs recorded (`life_run.json`), with the case file when the case is
+/// one as it is on disk (then `fretdyn life --resume DIR` continues it too).
+fn start_afresh(dir: &Path, fingerprint: u64, case_file: Option<&Path>) -> PyResult<()> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        FretdynError::new_err(format!("{}: cannot create the folder: {e}", dir.display()))
+    })?;
+    for name in OUTPUTS.iter().chain(&[CHECKPOINT_FILE]) {
+        let p = dir.join(name);
+        match std::fs::remove_file(&p) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(FretdynError::new_err(format!("{}: {e}", p.display())));
+            }
+            _ => {}
+        }
+    }
+    let mut info = serde_json::json!({ "fingerprint": fingerprint.to_string() });
+    if let Some(path) = case_file {
+        let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        info["case_file"] = serde_json::json!(absolute);
+    }
+    fretdyn::files::write_text_atomically(&dir.join(LIFE_RUN_FILE), &format!("{info:#}\n"))
+        .map_err(err)
+}
+
+/// The checkpoint to continue the life in `dir` from: refused when the inputs changed since
+/// the life started there, or when there is none (the CLI's checks, in Python's words).
+fn read_checkpoint(dir: &Path, fingerprint: u64) -> PyResult<LifeCheckpoint> {
+    let again = format!(
+        "start the life again: fretdyn.life(case, output={:?})",
+        dir.display().to_string()
+    );
+    let info: serde_json::Value = std::fs::read_to_string(dir.join(LIFE_RUN_FILE))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    if info["fingerprint"].as_str() != Some(fingerprint.to_string().as_str()) {
+        return Err(FretdynError::new_err(format!(
+            "{}: the case or a file it reads changed since the life in this folder started (or no life was started there); {again}",
+            dir.display()
+        )));
+    }
+    let checkpoint = dir.join(CHECKPOINT_FILE);
+    if !checkpoint.exists() {
+        return Err(FretdynError::new_err(format!(
+            "{}: no checkpoint to resume: the life there is over (life.json says how it ended) or stopped before its first checkpoint; {again}",
+            dir.display()
+        )));
+    }
+    let c = LifeCheckpoint::read(&checkpoint).map_err(err)?;
+    if c.fingerprint() != fingerprint {
+        return Err(FretdynError::new_err(format!(
+            "{}: written for other inputs than the case has now; {again}",
+            checkpoint.display()
+        )));
+    }
+    Ok(c)
+}
+
+/// The JSON of `life.json`, as `fretdyn life` writes it: the criterion and the results.
+fn life_json(r: &LifeResults, criterion: Option<f64>) -> String {
+    let json = serde_json::json!({ "criterion_depth": criterion, "results": r });
+    serde_json::to_string_pretty(&json).unwrap_or_default() + "\n"
+}
+
+/// The service life of a case with a `[life]` section (THEORY §14.5; `fretdyn life`), with
+/// the GIL released; Ctrl-C stops it after a checkpoint (KeyboardInterrupt, once the results
+/// so far are written). Returns the JSON of `life.json` (`criterion_depth`, `results`), and
+/// when the life reached its end, the lives with `max_depth_change` halved 1…`halvings`
+/// times: `(max_depth_change, JSON of their results)` each (the convergence check of
+/// `--halvings`). With `output` (a folder): the life's checkpoint (after every life step and
+/// every `checkpoint_every` s inside a window), `life_run.json` and `life.json` are written
+/// there, and `resume` continues the life stopped there (one the CLI started too: the same
+/// fingerprint); `case_file`, the file the case was read from unchanged, is recorded for
+/// `fretdyn life --resume`.
+#[pyfunction]
+#[pyo3(signature = (case, halvings = 0, output = None, resume = false, checkpoint_every = 60.0, case_file = None))]
+pub(crate) fn life(
+    py: Python<'_>,
+    case: &Case,
+    halvings: u32,
+    output: Option<PathBuf>,
+    resume: bool,
+    checkpoint_every: f64,
+    case_file: Option<PathBuf>,
+) -> PyResult<(String, Vec<(f64, String)>)> {
+    let c = &case.inner;
+    let Some(settings) = c.life.clone() else {
+        return Err(FretdynError::new_err(
+            "life: the case has no [life] section: add one with target_years (docs/WEAR.md)",
+        ));
+    };
+    if halvings > MAX_HALVINGS {
+        return Err(FretdynError::new_err(format!(
+            "halvings: at most {MAX_HALVINGS} (each about doubles the life steps), got {halvings}"
+        )));
+    }
+    if !(checkpoint_every.is_finite() && checkpoint_every > 0.0) {
+        // the CLI's message for --checkpoint-every
+        return Err(FretdynError::new_err(format!(
+            "checkpoint_every: must be a positive number of seconds (got {checkpoint_every})"
+        )));
+    }
+    // a case that cannot have a life, or cannot start its first window, is refused before
+    // anything is written
+    fretdyn::apps::life::check_life(c, &settings).map_err(err)?;
+    fretdyn::integrator::simulation::Simulation::with_recorder(&c.model, &c.settings, 1)
+        .map(drop)
+        .map_err(err)?;
+    let fingerprint = fingerprint(case)?;
+    let checkpoint_path = output.as_ref().map(|d| d.join(CHECKPOINT_FILE));
+    let resumed = match (&output, resume) {
+        (Some(dir), true) => Some(read_checkpoint(dir, fingerprint)?),
+        (Some(dir), false) => {
+            start_afresh(dir, fingerprint, case_file.as_deref())?;
+            None
+        }
+        (None, true) => {
+            return Err(FretdynError::new_err(
+                "resume: give the folder of the life to continue: fretdyn.life(case, output=DIR, resume=True)",
+            ));
+        }
+        (None, false) => None,
+    };
+    let (results, interrupted) = interruptible(py, |stop| {
+        let mut control = LifeControl {
+            checkpoint: checkpoint_path.as_deref(),
+            checkpoint_every_seconds: checkpoint_every,
+            fingerprint,
+            resume: resumed,
+            stop: Some(stop),
+        };
+        fretdyn::apps::life::service_life_with(c, &settings, &mut control, |_| {})
+    });
+    let results = results.map_err(err)?;
+    let json = life_json(&results, settings.criterion);
+    if let Some(dir) = &output {
+        fretdyn::files::write_text_atomically(&dir.join("life.json"), &json).map_err(err)?;
+        if !matches!(results.end, fretdyn::apps::life::LifeEnd::Stopped { .. }) {
+            // the life is over: nothing to resume
+            let _ = std::fs::remove_file(dir.join(CHECKPOINT_FILE));
+        }
+    }
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    let mut refined = Vec::new();
+    if results.end.is_finished() {
+        for h in 1..=halvings {
+            let finer = LifeSettings {
+                max_depth_change: settings.max_depth_change / f64::from(1u32 << h),
+                ..settings.clone()
+            };
+            let (r, interrupted) = interruptible(py, |stop| {
+                let mut control = LifeControl {
+                    stop: Some(stop),
+                    ..LifeControl::default()
+                };
+                fretdyn::apps::life::service_life_with(c, &finer, &mut control, |_| {})
+            });
+            if let Some(e) = interrupted {
+                return Err(e);
+            }
+            let r = r.map_err(err)?;
+            let text = serde_json::to_string(&r).unwrap_or_default();
+            refined.push((finer.max_depth_change, text));
+        }
+    }
+    Ok((json, refined))
+}
+
+/// The modal basis of a case (`fretdyn modes`): a dict with `frequencies_hz`,
+/// `damping_ratio` (numpy arrays, one value per mode), `points` (names), `rows` (numpy
+/// array points × 3 × modes: the translation of each point in each mode, mass-normalised),
+/// `coords` (points × 3, m), `abscissae` (per point, m, NaN where unknown), `participation`
+/// (3 × modes, Γ = ΦᵀMr, kg^0.5, or None when the basis does not know it) and, for a tube
+/// (`type = "tube"`), `tube`: a dict with `s` (the abscissa of each node along the tube, m),
+/// `nodes` (nodes × 3, m), `shapes` (modes × nodes × 3: the translations u_x, u_y, u_z of
+/// every node, 0 at a restrained one), `supports` (the abscissae of the nodes with a
+/// restrained translation, m) and `orthonormality_error` (max |ΦᵀMΦ − I|). With `output`
+/// (a folder, made if needed), the basis is written there as `basis.npz`, as `fretdyn modes`
+/// writes it (keys `frequencies_hz`, `damping_ratio`, `rows_<point>`, `coords_<point>`,
+/// `s_<point>`).
+#[pyfunction]
+#[pyo3(signature = (case, output = None))]
+pub(crate) fn modes<'py>(
+    py: Python<'py>,
+    case: &Case,
+    output: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use fretdyn::structure::beam::Dof;
+    let c = &case.inner;
+    let basis = &c.model.basis;
+    if let Some(dir) = &output {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            FretdynError::new_err(format!("{}: cannot create the folder: {e}", dir.display()))
+        })?;
+        fretdyn::structure::basis_file::write_basis_npz_with_abscissae(
+            &dir.join("basis.npz"),
+            basis,
+            &c.point_abscissae,
+        )
+        .map_err(err)?;
+    }
+    let p = basis.modes();
+    let out = PyDict::new(py);
+    let hz: Vec<f64> = basis
+        .omega
+        .iter()
+        .map(|w| w / std::f64::consts::TAU)
+        .collect();
+    out.set_item("frequencies_hz", PyArray1::from_vec(py, hz))?;
+    out.set_item(
+        "damping_ratio",
+        PyArray1::from_vec(py, basis.damping_ratio.clone()),
+    )?;
+    let names: Vec<&str> = basis.points.iter().map(|pt| pt.name.as_str()).collect();
+    out.set_item("points", names)?;
+    let n = basis.points.len();
+    let rows: Vec<f64> = basis
+        .points
+        .iter()
+        .flat_map(|pt| pt.rows.iter().copied())
+        .collect();
+    out.set_item("rows", PyArray1::from_vec(py, rows).reshape([n, 3, p])?)?;
+    let coords: Vec<f64> = basis
+        .points
+        .iter()
+        .flat_map(|pt| pt.coords.iter().copied())
+        .collect();
+    out.set_item("coords", PyArray1::from_vec(py, coords).reshape([n, 3])?)?;
+    let abscissae: Vec<f64> = (0..n)
+        .map(|k| {
+            c.point_abscissae
+                .get(k)
+                .copied()
+                .flatten()
+                .unwrap_or(f64::NAN)
+        })
+        .collect();
+    out.set_item("abscissae", PyArray1::from_vec(py, abscissae))?;
+    if basis.participation.len() == 3 * p {
+        let gamma = PyArray1::from_vec(py, basis.participation.clone()).reshape([3, p])?;
+        out.set_item("participation", gamma)?;
+    } else {
+        out.set_item("participation", py.None())?;
+    }
+    if let Some(tube) = &c.tube {
+        let mesh = &tube.structure.beam.mesh;
+        let a = &tube.basis.assembled;
+        let shapes = &tube.basis.modes.shapes;
+        let nodes = mesh.nodes.len();
+        // the abscissa along the path: the nodes are numbered along the tube
+        let mut s = vec![0.0; nodes];
+        for k in 1..nodes {
+            s[k] = s[k - 1] + (mesh.nodes[k] - mesh.nodes[k - 1]).norm();
+        }
+        let dofs = [Dof::Ux, Dof::Uy, Dof::Uz];
+        let m = shapes.ncols().min(p);
+        let mut u = Vec::with_capacity(m * nodes * 3);
+        for mode in 0..m {
+            for node in 0..nodes {
+                for d in dofs {
+                    u.push(a.reduced_index(node, d).map_or(0.0, |i| shapes[(i, mode)]));
+                }
+            }
+        }
+        let supports: Vec<f64> = (0..nodes)
+            .filter(|&k| dofs.iter().any(|&d| a.reduced_index(k, d).is_none()))
+            .map(|k| s[k])
+            .collect();
+        let positions: Vec<f64> = mesh.nodes.iter().flat_map(|x| x.iter().copied()).collect();
+        let t = PyDict::new(py);
+        t.set_item("s", PyArray1::from_vec(py, s))?;
+        t.set_item(
+            "nodes",
+            PyArray1::from_vec(py, positions).reshape([nodes, 3])?,
+        )?;
+        t.set_item("shapes", PyArray1::from_vec(py, u).reshape([m, nodes, 3])?)?;
+        t.set_item("supports", PyArray1::from_vec(py, supports))?;
+        t.set_item(
+            "orthonormality_error",
+            fretdyn::structure::eigen::orthonormality_error(&a.mass, shapes),
+        )?;
+        out.set_item("tube", t)?;
+    } else {
+        out.set_item("tube", py.None())?;
+    }
+    Ok(out)
+}
