@@ -9,7 +9,7 @@ use crate::Failure;
 
 /// The file a command holds an advisory lock on while it writes in its folder; the lock
 /// goes with the process, however it ends.
-pub const LOCK_FILE: &str = ".fretdyn.lock";
+pub use fretdyn::files::FOLDER_LOCK_FILE as LOCK_FILE;
 
 /// The lock of an output folder, held until dropped.
 pub struct FolderLock {

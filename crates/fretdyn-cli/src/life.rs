@@ -525,14 +525,9 @@ fn write(dir: &Path, title: &str, r: &LifeResults, criterion: Option<f64>) -> Re
         }
     }
     put("scars.csv", scars)?;
-    let json = serde_json::json!({
-        "title": title,
-        "criterion_depth": criterion,
-        "results": r,
-    });
     put(
         "life.json",
-        serde_json::to_string_pretty(&json).unwrap_or_default() + "\n",
+        fretdyn::apps::life::life_json(title, r, criterion),
     )
 }
 

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use fretdyn::apps::life::{LifeCheckpoint, LifeControl, LifeResults, LifeSettings};
+use fretdyn::apps::life::{LifeCheckpoint, LifeControl, LifeSettings};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -74,6 +74,25 @@ fn fingerprint(case: &Case) -> PyResult<u64> {
     Ok(fretdyn::case::fingerprint::Fingerprint::of(&value, &case.base_dir).value())
 }
 
+/// Creates the output folder `dir` and takes its lock ([`fretdyn::files::FOLDER_LOCK_FILE`]),
+/// or says who holds it.
+fn lock_folder(dir: &Path) -> PyResult<fretdyn::files::Lock> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        FretdynError::new_err(format!("{}: cannot create the folder: {e}", dir.display()))
+    })?;
+    match fretdyn::files::Lock::try_new(
+        &dir.join(fretdyn::files::FOLDER_LOCK_FILE),
+        "fretdyn.life (Python)",
+    ) {
+        Ok(Ok(lock)) => Ok(lock),
+        Ok(Err(holder)) => Err(FretdynError::new_err(format!(
+            "{}: {holder} is writing in this folder; wait for it to end, or give another output folder (output=...)",
+            dir.display()
+        ))),
+        Err(e) => Err(err(e)),
+    }
+}
+
 /// A new life in `dir`: the folder made, the files of an earlier life there removed, and the
 /// fingerprint of its inputs recorded (`life_run.json`), with the case file when the case is
 /// one as it is on disk (then `fretdyn life --resume DIR` continues it too).
@@ -133,12 +152,6 @@ fn read_checkpoint(dir: &Path, fingerprint: u64) -> PyResult<LifeCheckpoint> {
     Ok(c)
 }
 
-/// The JSON of `life.json`, as `fretdyn life` writes it: the criterion and the results.
-fn life_json(r: &LifeResults, criterion: Option<f64>) -> String {
-    let json = serde_json::json!({ "criterion_depth": criterion, "results": r });
-    serde_json::to_string_pretty(&json).unwrap_or_default() + "\n"
-}
-
 /// The service life of a case with a `[life]` section (THEORY §14.5; `fretdyn life`), with
 /// the GIL released; Ctrl-C stops it after a checkpoint (KeyboardInterrupt, once the results
 /// so far are written). Returns the JSON of `life.json` (`criterion_depth`, `results`), and
@@ -185,6 +198,9 @@ pub(crate) fn life(
         .map_err(err)?;
     let fingerprint = fingerprint(case)?;
     let checkpoint_path = output.as_ref().map(|d| d.join(CHECKPOINT_FILE));
+    // held until the life is written: another life (or `fretdyn run`/`sweep`/`life`) in the
+    // same folder is refused, as the CLI refuses it
+    let _lock = output.as_deref().map(lock_folder).transpose()?;
     let resumed = match (&output, resume) {
         (Some(dir), true) => Some(read_checkpoint(dir, fingerprint)?),
         (Some(dir), false) => {
@@ -209,7 +225,7 @@ pub(crate) fn life(
         fretdyn::apps::life::service_life_with(c, &settings, &mut control, |_| {})
     });
     let results = results.map_err(err)?;
-    let json = life_json(&results, settings.criterion);
+    let json = fretdyn::apps::life::life_json(&c.title, &results, settings.criterion);
     if let Some(dir) = &output {
         fretdyn::files::write_text_atomically(&dir.join("life.json"), &json).map_err(err)?;
         if !matches!(results.end, fretdyn::apps::life::LifeEnd::Stopped { .. }) {

@@ -6,6 +6,8 @@ The life is the multi-span tube of examples/tube_multispan_life.toml with 0.3 s 
 (about 0.6 s for its 40 years on a 2-core machine)."""
 
 import json
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -185,6 +187,34 @@ def test_a_finished_life_leaves_no_checkpoint_to_resume(lives):
     # another case: refused as changed
     with pytest.raises(fretdyn.FretdynError, match="changed since the life in this folder started"):
         fretdyn.life(folder / "case.toml", years=3.0, output=folder / "py", resume=True)
+
+
+def test_a_folder_another_program_writes_in_is_refused(tmp_path):
+    """A life refuses a folder whose lock another process holds (as `fretdyn run`/`sweep`/
+    `life` hold it while they write), and writes nothing there."""
+    path = short_life(tmp_path)
+    out = tmp_path / "busy"
+    out.mkdir()
+    holder = subprocess.Popen(
+        [sys.executable, "-c",
+         "import fcntl, sys, time\n"
+         "f = open(sys.argv[1], 'a')\n"
+         "fcntl.flock(f, fcntl.LOCK_EX)\n"
+         "print('held', flush=True)\n"
+         "time.sleep(60)\n",
+         str(out / ".fretdyn.lock")],
+        stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        with pytest.raises(fretdyn.FretdynError, match="is writing in this folder"):
+            fretdyn.life(path, output=out)
+        assert sorted(p.name for p in out.iterdir()) == [".fretdyn.lock"]
+    finally:
+        holder.kill()
+        holder.wait()
+    # once the holder is gone, the folder is free
+    fretdyn.life(path, years=1.0, output=out)
+    assert (out / "life.json").exists()
 
 
 # a pinned–pinned tube without fluid, 1 m, fine mesh (its twist held at one end: no rigid

@@ -33,6 +33,10 @@ pub fn write_text_atomically(path: &Path, text: &str) -> Result<()> {
     })
 }
 
+/// The file in an output folder that a program writing there (`fretdyn run`, `sweep`,
+/// `life`, Python's `fretdyn.life`) holds a [`Lock`] on, so that two never mix their results.
+pub const FOLDER_LOCK_FILE: &str = ".fretdyn.lock";
+
 /// An exclusive advisory lock on a file (`flock` on Unix, `LockFileEx` on Windows), held
 /// until dropped; the operating system lets it go with the process, however the process
 /// ends (killed, out of memory), so a lock is never left behind.

@@ -270,8 +270,8 @@ class LifeResult:
         Returns
         -------
         dict
-            ``criterion_depth`` (m or None) and ``results`` (contacts, clearances, steps,
-            times to the criterion in s, scars, end, windows, wall_time).
+            ``title`` (the case's), ``criterion_depth`` (m or None) and ``results`` (contacts,
+            clearances, steps, times to the criterion in s, scars, end, windows, wall_time).
 
         Examples
         --------

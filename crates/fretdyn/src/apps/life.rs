@@ -725,6 +725,17 @@ pub fn service_life(
     service_life_with(case, life, &mut LifeControl::default(), observer)
 }
 
+/// The text of `life.json`, as `fretdyn life` and Python's `fretdyn.life` write it: the case
+/// `title`, the plugging `criterion_depth` (m, or null) and the `results`.
+pub fn life_json(title: &str, results: &LifeResults, criterion: Option<f64>) -> String {
+    let json = serde_json::json!({
+        "title": title,
+        "criterion_depth": criterion,
+        "results": results,
+    });
+    serde_json::to_string_pretty(&json).unwrap_or_default() + "\n"
+}
+
 /// Whether contact `k` of `model` has a wear law.
 fn wears(model: &Model, k: usize) -> bool {
     model.wear.get(k).is_some_and(|w| w.is_some())
