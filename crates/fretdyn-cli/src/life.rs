@@ -468,8 +468,8 @@ fn convergence(
 
 /// Largest relative change of the deepest scar's depth at the last halving of `--halvings`
 /// that still counts as converged: one window's wear work rate has a standard error of
-/// 4–8 % at the loaded plates of `examples/tube_multispan_life.toml`, and a depth goes as
-/// the volume to the power 2/3 or less, so that a smaller change is noise.
+/// 5–16 % at the loaded plates of `examples/tube_multispan_life.toml` (docs/WEAR.md), and a
+/// depth goes as the volume to the power 2/3 or less, so that a smaller change is noise.
 pub const CONVERGED_CHANGE: f64 = 0.05;
 
 /// The warning when the last halving changed the depth of the deepest scar (in `after`,

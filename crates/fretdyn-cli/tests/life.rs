@@ -135,6 +135,9 @@ fn a_life_writes_its_depths_against_time_and_converges_under_halvings() {
         })
         .collect();
     assert!((ends[0] - ends[1]).abs() < 1e-6 * ends[0]);
+    // converged: no warning that the last halving moved the depth
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("not converged"), "{stderr}");
     assert!(
         std::fs::metadata(s.0.join("out/convergence.png"))
             .unwrap()

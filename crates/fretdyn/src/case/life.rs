@@ -31,7 +31,7 @@ pub(super) struct LifeSection {
 /// windows) the deepest scar (plate 3) at 0.1, 0.05, 0.025 and 0.0125 is −16 %, −10 %, 0.0 %
 /// and +2.6 % off its depth at 0.00625, for 2, 3, 7 and 14 windows (docs/WEAR.md, the
 /// convergence table): 0.025 is within the noise of one window's wear work rate (a standard
-/// error of 4–8 % at the loaded plates), for about twice the windows of 0.05.
+/// error of 5–16 % at the loaded plates), for about twice the windows of 0.05.
 fn default_change() -> f64 {
     DEFAULT_MAX_DEPTH_CHANGE
 }
