@@ -19,11 +19,14 @@ Rewriting replaces the text between the markers; `--check` runs the same command
 printing the difference, if a doc says anything else. The commands are deterministic (seeded
 studies, seeded turbulence): the same binary gives the same numbers on any run.
 
-Blocks marked `ci` are checked by `--check` (about a minute on 2 idle cores: the life
-convergence table and the worked example of the volume split); the others (a probabilistic
-life of 40 samples, the bins and Lim's coefficient) by `--check --all` or when rewriting
-(several minutes). Outputs go to `--out` (default target/doc_numbers); `--reuse` renders from
-the outputs already there instead of running the commands again.
+Blocks marked `ci` are checked by `--check`: the worked example of the volume split, the life
+convergence table (53 windows), the example's life and the flow-velocity study (14 runs) —
+about 65 s of CPU; 428 s measured on a 2-core machine shared with other builds (a load of 4–5
+per core). The others (a probabilistic life of 40 samples, 4.5 minutes of CPU; the angular
+bins; Lim's coefficient, 109 windows; the probabilistic clearance study, 120 runs) by `--check
+--all` or when rewriting: about half an hour on that machine. Outputs go to `--out` (default
+target/doc_numbers); `--reuse` renders from the outputs already there instead of running the
+commands again.
 """
 
 import argparse
