@@ -53,14 +53,7 @@ pub struct Options {
 pub fn main(o: &Options) -> Result<(), Failure> {
     let (path, dir) = match (&o.case, &o.resume) {
         (Some(path), None) => {
-            let stem = path
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "case".into());
-            let dir = o
-                .output
-                .clone()
-                .unwrap_or_else(|| PathBuf::from("fretdyn_results").join(format!("{stem}_life")));
+            let dir = o.output.clone().unwrap_or_else(|| default_dir(path));
             (path.clone(), dir)
         }
         (None, Some(dir)) => (recorded_case(dir)?, dir.clone()),
@@ -265,6 +258,14 @@ pub fn main(o: &Options) -> Result<(), Failure> {
     Ok(())
 }
 
+/// The folder a life writes in when not told: `life/` inside the folder `fretdyn run` of the
+/// same case writes in (`fretdyn_results/<case name>/life`), so that a case's run and life sit
+/// together, neither overwrites the other, and a case named `*_life.toml` does not get a
+/// doubled `_life_life` suffix.
+pub fn default_dir(case: &Path) -> PathBuf {
+    crate::run::default_dir("case", case).join("life")
+}
+
 /// The case file of the life in `dir` (`life_run.json`), for `--resume`.
 fn recorded_case(dir: &Path) -> Result<PathBuf, Failure> {
     let run_file = dir.join(LIFE_RUN_FILE);
@@ -456,7 +457,40 @@ fn convergence(
             p.display()
         ))));
     }
+    if let [.., before, after] = &lives[..]
+        && let Some(w) = unconverged(&first.contacts, &end_depths(before), &end_depths(after))
+    {
+        errln!("warning: {w}");
+    }
     Ok(Ok(()))
+}
+
+/// Largest relative change of the deepest scar's depth at the last halving of `--halvings`
+/// that still counts as converged: one window's wear work rate has a standard error of
+/// 5–16 % at the loaded plates of `examples/tube_multispan_life.toml` (docs/WEAR.md), and a
+/// depth goes as the volume to the power 2/3 or less, so that a smaller change is noise.
+pub const CONVERGED_CHANGE: f64 = 0.05;
+
+/// The warning when the last halving changed the depth of the deepest scar (in `after`,
+/// the finer life) by more than [`CONVERGED_CHANGE`]; lightly worn contacts are left out:
+/// their depths move by ±10 % with the windows' noise, whatever the life step.
+fn unconverged(names: &[String], before: &[f64], after: &[f64]) -> Option<String> {
+    let (k, deepest) = after
+        .iter()
+        .copied()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let change = (deepest - before[k]) / deepest;
+    (deepest > 0.0 && change.abs() > CONVERGED_CHANGE).then(|| {
+        format!(
+            "life: the last halving of max_depth_change changed the depth of the deepest scar ('{}') by {:+.1} % ({} to {} µm), more than {} %: the life is not converged; lower life.max_depth_change",
+            names[k],
+            100.0 * change,
+            significant(before[k] * 1e6, 4),
+            significant(deepest * 1e6, 4),
+            100.0 * CONVERGED_CHANGE
+        )
+    })
 }
 
 /// Each contact's tube depth at the end of a life.
@@ -728,4 +762,27 @@ fn draw(path: &Path, title: &str, t: &LifeTable, criterion: Option<f64>) -> Resu
             ..Layout::default()
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_last_halving_warns_when_the_deepest_scar_moved_by_more_than_the_tolerance() {
+        let names = ["a".to_string(), "b".to_string()];
+        // the deepest scar ('b') 19.19 → 21.34 µm: +10.1 %; 'a' moved by 20 % but is shallow
+        let w = unconverged(&names, &[5e-6, 19.19e-6], &[6e-6, 21.34e-6]).unwrap();
+        assert!(w.contains("'b'") && w.contains("+10.1 %"), "{w}");
+        assert!(w.contains("19.19 to 21.34 µm"), "{w}");
+        // 21.34 → 21.90 µm: +2.6 %, converged, whatever the shallow scar did
+        assert_eq!(
+            unconverged(&names, &[5e-6, 21.34e-6], &[7e-6, 21.90e-6]),
+            None
+        );
+        // a decrease counts as much as an increase
+        assert!(unconverged(&names, &[0.0, 21.0e-6], &[0.0, 19.0e-6]).is_some());
+        // no wear at all: nothing to say
+        assert_eq!(unconverged(&names, &[0.0, 0.0], &[0.0, 0.0]), None);
+    }
 }

@@ -148,7 +148,8 @@ enum Command {
         /// written after every life step too).
         #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
         checkpoint_every: f64,
-        /// Output folder [default: fretdyn_results/<case name>_life].
+        /// Output folder [default: fretdyn_results/<case name>/life, beside what `fretdyn run`
+        /// of the case writes].
         #[arg(short, long, value_parser = path)]
         output: Option<PathBuf>,
         /// Do not draw life.png.

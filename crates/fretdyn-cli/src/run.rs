@@ -297,7 +297,8 @@ fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
     Ok(())
 }
 
-fn default_dir(title: &str, path: &Path) -> PathBuf {
+/// The folder `fretdyn run` writes in when not told: `fretdyn_results/<case file's stem>`.
+pub fn default_dir(title: &str, path: &Path) -> PathBuf {
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

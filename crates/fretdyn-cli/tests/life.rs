@@ -135,12 +135,59 @@ fn a_life_writes_its_depths_against_time_and_converges_under_halvings() {
         })
         .collect();
     assert!((ends[0] - ends[1]).abs() < 1e-6 * ends[0]);
+    // converged: no warning that the last halving moved the depth
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("not converged"), "{stderr}");
     assert!(
         std::fs::metadata(s.0.join("out/convergence.png"))
             .unwrap()
             .len()
             > 10_000
     );
+}
+
+/// Without `-o`, a life writes in `life/` inside the folder `fretdyn run` of the same case
+/// writes in: a case named `*_life.toml` gets no doubled `_life_life` suffix, and its run and
+/// its life, in either order, leave each other's files in place.
+#[test]
+fn a_life_without_a_folder_writes_beside_the_run_of_its_case() {
+    let s = Scratch::new("default-folder");
+    // a short life: 2 life steps of the 1.5 s windows
+    let case = CASE.replace("max_depth_change = 0.2", "max_depth_change = 1.0");
+    std::fs::write(s.0.join("bar_life.toml"), case).unwrap();
+    let out = fretdyn(&["life", "bar_life.toml", "--no-plots"], &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let life = s.0.join("fretdyn_results/bar_life/life");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains(&format!(
+            "wrote {}",
+            Path::new("fretdyn_results/bar_life/life").display()
+        )),
+        "{stdout}"
+    );
+    let table = std::fs::read_to_string(life.join("life.csv")).unwrap();
+    assert!(!s.0.join("fretdyn_results/bar_life_life").exists());
+    let out = fretdyn(&["run", "bar_life.toml", "--quiet", "--no-plots"], &s.0);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(s.0.join("fretdyn_results/bar_life/summary.json").exists());
+    assert_eq!(
+        std::fs::read_to_string(life.join("life.csv")).unwrap(),
+        table,
+        "the run changed the life's table"
+    );
+    let out = fretdyn(&["life", "bar_life.toml", "--no-plots"], &s.0);
+    assert!(out.status.success());
+    assert!(s.0.join("fretdyn_results/bar_life/summary.json").exists());
+    assert!(life.join("life.json").exists());
 }
 
 #[test]

@@ -39,6 +39,9 @@ use crate::wear::{ContactWear, HoleScar, Scar, WearWork};
 /// Seconds in a year (365.25 days).
 pub const YEAR: f64 = 365.25 * 86_400.0;
 
+/// `max_depth_change` when `[life]` does not give it (measured in `case/life.rs`).
+pub const DEFAULT_MAX_DEPTH_CHANGE: f64 = 0.025;
+
 /// Most angular bins of a hole's scar profile (0.1° bins): the wear map holds two numbers
 /// per bin and contact, and a life step spreads each bin's volume over the others.
 pub const MAX_ANGULAR_BINS: usize = 3600;
@@ -80,7 +83,7 @@ impl LifeSettings {
             return Err(Error::invalid(
                 format!("{field}.max_depth_change"),
                 format!(
-                    "must be a fraction in (0, 1] (got {}); 0.1 is a good start, halve it to check convergence",
+                    "must be a fraction in (0, 1] (got {}); {DEFAULT_MAX_DEPTH_CHANGE} (the default) is a good start, halve it to check convergence (fretdyn life --halvings)",
                     self.max_depth_change
                 ),
             ));
