@@ -5,7 +5,7 @@
 # cases of `PERF_DIR` (S1 with fretdyn's four methods against C's Gauss–Seidel radial, and
 # the 16 grid cases with Gauss–Seidel radial), both counted by callgrind over the same first
 # STEPS steps (default 10 000) of the same trajectory. Exact and repeatable where timings on a
-# shared machine are not (the machine runs at two speeds, docs/PERFORMANCE.md): the ratio
+# shared machine are not (the machine runs at two speeds, docs/dev/PERFORMANCE_LOG.md): the ratio
 # C/fretdyn of this table is the time ratio fretdyn/C that a machine running both programs
 # at the same instructions per cycle would give.
 #   fretdyn: callgrind's inclusive count of `Simulation::steps` (the time loop, every

@@ -4,7 +4,7 @@
 # Instructions per time step of one run: callgrind's inclusive count of `Simulation::steps`
 # (the time loop: no set-up, no file output) divided by the run's steps (summary.json). Exact
 # and repeatable where timings on a shared machine are not: the figure for changes of a few
-# per cent in docs/PERFORMANCE.md. Use the `profiling` build (the release build's machine
+# per cent in docs/dev/PERFORMANCE_LOG.md. Use the `profiling` build (the release build's machine
 # code with symbols): `cargo build --profile profiling --locked -p fretdyn-cli`. Needs
 # valgrind and python3. A 20 000-step run takes about a minute.
 #   bash scripts/instructions_per_step.sh target/profiling/fretdyn examples/tube_multispan.toml

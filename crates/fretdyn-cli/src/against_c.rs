@@ -221,7 +221,7 @@ fn check_options(options: &Options) -> Result<(), Failure> {
         }
         if !file.is_file() {
             return Err(Failure::input(format!(
-                "--write {}: no such file; give an existing markdown file (e.g. docs/PERFORMANCE.md)",
+                "--write {}: no such file; give an existing markdown file (e.g. docs/dev/PERFORMANCE_LOG.md)",
                 file.display()
             )));
         }

@@ -6,7 +6,7 @@
 //!   ([`percentiles`]);
 //! - [`verification`]: the verification cases against closed forms (THEORY §6,
 //!   `docs/VERIFICATION.md`);
-//! - [`benchmark`]: the step-speed benchmark case (`docs/PERFORMANCE.md`);
+//! - [`benchmark`]: the step-speed benchmark case (`docs/PERFORMANCE.md`, `docs/dev/PERFORMANCE_LOG.md`);
 //! - [`life`]: the service life — wear depth over years with the scars fed back (THEORY §14.5).
 
 pub mod benchmark;
