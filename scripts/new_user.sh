@@ -159,20 +159,14 @@ table = f"{work}/python_study.csv"
 t = fretdyn.sweep(study, table, fresh=True)
 print(f"fretdyn.sweep: {len(t)} runs ({time.perf_counter() - t0:.1f} s)")
 p = fretdyn.percentiles(study, table)
-rows = p["rows"] if isinstance(p, dict) else p.to_dict("records")
-for row in rows[:4]:
-    print(f"  {row['column']} P{row['level']:g}: {row['estimate'] * 1e3:.3g} mW")
+for row in p.head(4).itertuples():                 # a DataFrame, as sweep's table
+    print(f"  {row.column} P{row.level}: {row.estimate * 1e3:.3g} mW")
 
-# fretdyn.life is being added by issue [3.2]'s Python part; until it is merged this step says
-# so instead of failing. TODO([3.2], after the merge): drop the hasattr guard and print the
-# depth at 40 years per contact from what fretdyn.life returns.
-if hasattr(fretdyn, "life"):
-    t0 = time.perf_counter()
-    life = fretdyn.life("examples/tube_multispan_life.toml")
-    print(f"fretdyn.life ({time.perf_counter() - t0:.1f} s):")
-    print(getattr(life, "summary", life))
-else:
-    print("fretdyn.life: not in this version of the package (skipped)")
+t0 = time.perf_counter()
+life = fretdyn.life("examples/tube_multispan_life.toml", output=f"{work}/python_life")
+print(f"fretdyn.life ({time.perf_counter() - t0:.1f} s): tube depth at the end ± its "
+      "standard error, µm")
+print((life.summary[["tube_depth", "tube_depth_se"]] * 1e6).round(2).to_string())
 PY
   )
 }

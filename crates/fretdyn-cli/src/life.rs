@@ -380,13 +380,13 @@ fn convergence(
             ))));
         }
         if let Err(e) = outln!(
-            "max_depth_change = {}: {} life steps, {}, tube depth at the end (m) {}",
+            "max_depth_change = {}: {} life steps, {}, tube depth at the end (µm) {}",
             refined.max_depth_change,
             r.steps.len() - 1,
             r.end.name(),
             end_depths(&r)
                 .iter()
-                .map(|d| format!("{d:.4e}"))
+                .map(|d| significant(d * 1e6, 4))
                 .collect::<Vec<_>>()
                 .join(" ")
         ) {
