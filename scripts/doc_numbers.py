@@ -393,6 +393,21 @@ def flow_velocity(run):
     return "\n".join(out)
 
 
+# ---- VERIFICATION.md: contact forces and wear against the number of modes -----------------
+
+def mode_convergence(run):
+    """The table the `mode_convergence` example prints (9 runs of 0.1 s, under a second)."""
+    folder = run.out / "verification/mode_convergence"
+    p = subprocess.run(["cargo", "run", "--release", "--locked", "-q", "-p", "fretdyn-cli",
+                        "--example", "mode_convergence", "--", str(folder)],
+                       cwd=ROOT, capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit(f"the mode_convergence example exited {p.returncode}:\n{p.stderr}")
+    rows = [line for line in p.stdout.splitlines() if line.startswith("|")]
+    # the all-mode row's errors are exactly zero
+    return "\n".join(re.sub(r"\| 0\.00e0(?= )", "| 0", line) for line in rows)
+
+
 # name: (file, render, affordable in CI)
 BLOCKS = {
     "wear-split": ("docs/WEAR.md", wear_split, True),
@@ -404,6 +419,7 @@ BLOCKS = {
     "life-probabilistic": ("docs/WEAR.md", life_probabilistic, False),
     "studies-percentiles": ("docs/STUDIES.md", studies_percentiles, False),
     "flow-velocity": ("docs/FLOW.md", flow_velocity, True),
+    "mode-convergence": ("docs/VERIFICATION.md", mode_convergence, True),
 }
 
 

@@ -11,6 +11,9 @@
 #[path = "../src/plot.rs"]
 mod plot;
 
+#[path = "../../fretdyn/tests/common/mode_truncation.rs"]
+mod mode_truncation;
+
 use std::path::Path;
 
 use fretdyn::case::Case;
@@ -23,10 +26,7 @@ fn main() {
     let counts = [2usize, 4, 8, 12, 16, 24, 32, 48, 114];
     let mut rows = Vec::new();
     for n in counts {
-        let t = text
-            .replace("modes = 12", &format!("modes = {n}"))
-            .replace("duration = 0.5", "duration = 0.1")
-            .replace("dt = 1e-5", "dt = 1e-6");
+        let t = mode_truncation::with_modes(&text, n);
         let case = Case::from_toml_str(&t, &root.join("examples")).expect("valid case");
         let r = simulate(&case.model, &case.settings).expect("run");
         let c = &r.contacts[0];

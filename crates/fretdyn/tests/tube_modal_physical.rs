@@ -2,6 +2,9 @@
 //! the modal run equals the physical-coordinates run for each tangential method; with
 //! truncated bases, contact forces and wear converge as modes are added.
 
+#[path = "common/mode_truncation.rs"]
+mod mode_truncation;
+use mode_truncation::with_modes;
 use std::path::Path;
 
 use fretdyn::case::Case;
@@ -262,10 +265,7 @@ fn truncated_bases_converge_to_the_all_mode_solution() {
     let text =
         std::fs::read_to_string(root.join("examples/tube_clamped_one_support.toml")).unwrap();
     let measure = |n: usize| {
-        let t = text
-            .replace("modes = 12", &format!("modes = {n}"))
-            .replace("duration = 0.5", "duration = 0.1")
-            .replace("dt = 1e-5", "dt = 1e-6");
+        let t = with_modes(&text, n);
         let case = Case::from_toml_str(&t, &root.join("examples")).unwrap();
         assert_eq!(case.model.basis.modes(), n);
         let r = simulate(&case.model, &case.settings).unwrap();
