@@ -320,7 +320,10 @@ def stopped_life(path, out, by_cli=False):
     script = "import sys, fretdyn\nfretdyn.life(sys.argv[1], output=sys.argv[2], checkpoint_every=0.001)\n"
     command = ([FRETDYN, "life", str(path), "-o", str(out), "--no-plots", "--checkpoint-every", "0.001"]
                if by_cli else [sys.executable, "-c", script, str(path), str(out)])
-    child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    # SIGINT as in a terminal: a test run in the background (`cmd &` in a script, as CI may
+    # launch it) inherits SIGINT ignored, and Python then installs no KeyboardInterrupt handler
+    child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     checkpoint = out / "life_checkpoint.bin"
     deadline = time.time() + 120
     while not checkpoint.exists() and child.poll() is None and time.time() < deadline:
