@@ -59,12 +59,10 @@ pub fn scaling(dir: &Path, steps: u64) -> Result<(), Failure> {
     outln!("machine: {}, {steps} steps per run, best of 2", cpu_model())?;
     outln!("| method | modes | contacts | mean closed | µs/step | steps/s |")?;
     outln!("|---|---|---|---|---|---|")?;
-    let mut csv = String::from("method,modes,contacts,mean_closed,us_per_step,steps_per_s\n");
-    // per method, per contact count: (modes, µs/step)
-    let mut curves: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
+    let mut csv = String::from(SCALING_HEADER);
+    csv.push('\n');
     for method in methods() {
         for &contacts in &SCALING_CONTACTS {
-            let (mut xs, mut ys) = (Vec::new(), Vec::new());
             for &modes in &SCALING_MODES {
                 let mut case = rattling_tube(modes, contacts, method, steps);
                 case.settings.output_every = steps.max(1);
@@ -93,28 +91,82 @@ pub fn scaling(dir: &Path, steps: u64) -> Result<(), Failure> {
                     case.model.basis.modes(),
                     1e6 / us
                 ));
-                xs.push(case.model.basis.modes() as f64);
-                ys.push(us);
             }
-            curves.push((format!("{}, {contacts} contacts", method.name()), xs, ys));
         }
     }
-    let csv_path = dir.join("scaling.csv");
+    let csv_path = dir.join(SCALING_FILE);
     std::fs::write(&csv_path, csv)
         .map_err(|e| Failure::failed(format!("{}: {e}", csv_path.display())))?;
-    let panels: Vec<(String, Vec<Series>)> = methods()
+    let png = draw_scaling(dir).map_err(Failure::failed)?;
+    outln!("wrote {} and {}", csv_path.display(), png.display())?;
+    Ok(())
+}
+
+/// The table `fretdyn bench --scaling` writes, and its header.
+pub const SCALING_FILE: &str = "scaling.csv";
+const SCALING_HEADER: &str = "method,modes,contacts,mean_closed,us_per_step,steps_per_s";
+
+/// `scaling.png` of a folder with a `scaling.csv` (`bench --scaling`, or `fretdyn plot`
+/// again): µs per step against the modes, one panel per method, a curve per contact count, in
+/// the table's order. Returns the figure's path.
+pub fn draw_scaling(dir: &Path) -> Result<std::path::PathBuf, String> {
+    let path = dir.join(SCALING_FILE);
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut lines = text.lines();
+    if lines.next() != Some(SCALING_HEADER) {
+        return Err(format!(
+            "{}: not a table of fretdyn bench --scaling (its header is {SCALING_HEADER})",
+            path.display()
+        ));
+    }
+    // (method, contacts) → (modes, µs per step), in the table's order
+    let mut curves: Vec<(String, String, Vec<f64>, Vec<f64>)> = Vec::new();
+    for (i, line) in lines.enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        let bad = || {
+            format!(
+                "{} line {}: {line:?} is not a row of the table",
+                path.display(),
+                i + 2
+            )
+        };
+        let [method, modes, contacts, _, us, _] = f[..] else {
+            return Err(bad());
+        };
+        let (Ok(modes), Ok(us)) = (modes.parse::<f64>(), us.parse::<f64>()) else {
+            return Err(bad());
+        };
+        match curves.iter_mut().find(|c| c.0 == method && c.1 == contacts) {
+            Some(c) => {
+                c.2.push(modes);
+                c.3.push(us * 1e-6);
+            }
+            None => curves.push((method.into(), contacts.into(), vec![modes], vec![us * 1e-6])),
+        }
+    }
+    let mut methods: Vec<&str> = Vec::new();
+    for c in &curves {
+        if !methods.contains(&c.0.as_str()) {
+            methods.push(&c.0);
+        }
+    }
+    let panels: Vec<(String, Vec<Series>)> = methods
         .iter()
         .map(|m| {
             let series = curves
                 .iter()
-                .filter(|(label, _, _)| label.starts_with(m.name()))
-                .map(|(label, x, y)| Series {
-                    label: label.clone(),
-                    x,
-                    y,
+                .filter(|c| c.0 == *m)
+                .map(|c| Series {
+                    label: if c.1 == "1" {
+                        "1 contact".to_string()
+                    } else {
+                        format!("{} contacts", c.1)
+                    },
+                    x: &c.2,
+                    y: &c.3,
                 })
                 .collect();
-            (m.name().to_string(), series)
+            (m.to_string(), series)
         })
         .collect();
     let png = dir.join("scaling.png");
@@ -122,12 +174,10 @@ pub fn scaling(dir: &Path, steps: u64) -> Result<(), Failure> {
         &png,
         "Wall time per step of the synthetic rattling tube",
         "modes",
-        "µs per step",
+        "time per step (s)",
         &panels,
-    )
-    .map_err(Failure::failed)?;
-    outln!("wrote {} and {}", csv_path.display(), png.display())?;
-    Ok(())
+    )?;
+    Ok(png)
 }
 
 /// `fretdyn bench --pair A B`: the two cases run in this process alternately, the order

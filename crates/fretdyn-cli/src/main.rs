@@ -86,10 +86,10 @@ enum Command {
     },
     /// Draw the figures of a folder fretdyn wrote again: a run's (forces, displacements,
     /// orbits in the holes, peak-force histograms, wear work rates), a study's (study.png,
-    /// percentiles.png), a life's (life.png) or a modes folder's (mode_shapes.png); the kind
-    /// of folder is told by the files in it.
+    /// percentiles.png), a life's (life.png), a modes folder's (mode_shapes.png) or `bench
+    /// --scaling`'s (scaling.png); the kind of folder is told by the files in it.
     Plot {
-        /// Folder written by `fretdyn run`, `sweep`, `life` or `modes`.
+        /// Folder written by `fretdyn run`, `sweep`, `life`, `modes` or `bench --scaling`.
         #[arg(value_parser = path)]
         dir: PathBuf,
         /// The y axis of a study's study.png: log when the values span two decades or more

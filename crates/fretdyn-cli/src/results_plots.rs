@@ -450,20 +450,21 @@ fn histogram(values: &[f64], per_decade: usize) -> Vec<Bin> {
 }
 
 /// The kinds of folder fretdyn writes, by the file that tells them apart.
-const FOLDER_KINDS: [(&str, &str); 4] = [
+const FOLDER_KINDS: [(&str, &str); 5] = [
     ("summary.json", "a run"),
     ("study.csv", "a study (sweep)"),
     ("life.json", "a life"),
     (crate::modes::SHAPES_FILE, "a modes folder"),
+    (crate::bench::SCALING_FILE, "bench --scaling"),
 ];
 
 /// Draws again every figure of a folder fretdyn wrote — a run, a study (`study.png` and
-/// `percentiles.png`), a life or a modes folder —, its kind told by the files in it; returns
+/// `percentiles.png`), a life, a modes folder or `bench --scaling`'s —, its kind told by the files in it; returns
 /// the files written. `y_scale`: the y axis of a study's `study.png`.
 pub fn plot_folder(dir: &Path, y_scale: YScale) -> Result<Vec<PathBuf>, Failure> {
     if !dir.is_dir() {
         return Err(Failure::input(format!(
-            "{}: no such folder (give a folder written by fretdyn run, sweep, life or modes)",
+            "{}: no such folder (give a folder written by fretdyn run, sweep, life, modes or bench --scaling)",
             dir.display()
         )));
     }
@@ -480,6 +481,9 @@ pub fn plot_folder(dir: &Path, y_scale: YScale) -> Result<Vec<PathBuf>, Failure>
     }
     if has(crate::modes::SHAPES_FILE) {
         written.push(crate::modes::draw_folder(dir).map_err(Failure::failed)?);
+    }
+    if has(crate::bench::SCALING_FILE) {
+        written.push(crate::bench::draw_scaling(dir).map_err(Failure::input)?);
     }
     if written.is_empty() && !FOLDER_KINDS.iter().any(|(f, _)| has(f)) {
         let kinds: Vec<String> = FOLDER_KINDS

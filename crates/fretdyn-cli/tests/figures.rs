@@ -484,6 +484,56 @@ fn plot_names_a_folder_it_cannot_draw() {
     );
 }
 
+/// `fretdyn plot` of a `bench --scaling` folder draws scaling.png from scaling.csv: a panel
+/// per method in the table's order, a curve per contact count, the table's µs per step in
+/// seconds on the axis; a table that is not one is refused naming its line.
+#[test]
+fn scaling_figure_is_drawn_again_from_its_table() {
+    let s = Scratch::new("scaling");
+    let dir = s.0.join("scaling");
+    std::fs::create_dir_all(&dir).unwrap();
+    let header = "method,modes,contacts,mean_closed,us_per_step,steps_per_s";
+    let rows = [
+        ("penalty", 10, 1, 0.25),
+        ("penalty", 50, 1, 0.5),
+        ("penalty", 10, 5, 0.75),
+        ("penalty", 50, 5, 1.5),
+        ("gauss_seidel", 10, 1, 0.5),
+        ("gauss_seidel", 50, 1, 2.0),
+    ];
+    let mut csv = format!("{header}\n");
+    for (m, modes, contacts, us) in rows {
+        csv.push_str(&format!("{m},{modes},{contacts},0.1,{us},{}\n", 1e6 / us));
+    }
+    std::fs::write(dir.join("scaling.csv"), &csv).unwrap();
+    fretdyn(&["plot", "scaling"], &s.0);
+    let r = record(&dir.join("scaling.png"));
+    let p = panels(&r);
+    let captions: Vec<&str> = p.iter().map(|q| q["caption"].as_str().unwrap()).collect();
+    assert_eq!(captions, ["penalty", "gauss_seidel"]);
+    assert_eq!(p[0]["keys"], serde_json::json!(["1 contact", "5 contacts"]));
+    assert_eq!(p[1]["keys"], serde_json::json!(["1 contact"]));
+    let series = p[0]["series"].as_array().unwrap();
+    assert_eq!(f(&series[1]["max_y"]), 1.5e-6);
+    assert_eq!(f(&series[1]["min_y"]), 0.75e-6);
+    assert_eq!(series[1]["points"], 2);
+    assert_eq!(p[0]["y"]["title"], "time per step (µs)");
+    // a row that is not one: refused, naming the file and the line
+    std::fs::write(
+        dir.join("scaling.csv"),
+        format!("{csv}penalty,ten,1,0.1,0.2,5e6\n"),
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+        .args(["plot", "scaling"])
+        .current_dir(&s.0)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("scaling.csv line 8"), "{err}");
+}
+
 /// The figures committed under docs/figures are what the code draws today: the cheap ones
 /// (scripts/regenerate_figures.sh --cheap, about a minute) drawn again and compared byte for
 /// byte (plotters' PNGs are deterministic); the costly ones are listed in the script's header.
@@ -525,7 +575,7 @@ fn committed_figures_are_what_the_code_draws() {
             }
         }
     }
-    assert_eq!(compared, 5);
+    assert_eq!(compared, 6);
     assert!(
         stale.is_empty(),
         "docs/figures differ from what the code draws: {stale:?}; run scripts/regenerate_figures.sh"
