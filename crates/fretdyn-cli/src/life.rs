@@ -15,28 +15,11 @@ use fretdyn::case::Case;
 use fretdyn::error::number;
 
 use crate::Failure;
+pub use fretdyn::apps::life::MAX_HALVINGS;
+use fretdyn::apps::life::{CHECKPOINT_FILE, LIFE_RUN_FILE, OUTPUTS};
+
 use crate::out::{errln, outln};
 use crate::plot::{self, Layout, Mark, Panel, Series, YScale};
-
-/// Most halvings of `--halvings` (each about doubles the life steps of the one before).
-pub const MAX_HALVINGS: u32 = 10;
-
-/// The file that records which case a life's folder belongs to, for `--resume`.
-const LIFE_RUN_FILE: &str = "life_run.json";
-
-/// The checkpoint of a life ([`fretdyn::apps::life::LifeCheckpoint`]).
-const CHECKPOINT_FILE: &str = "life_checkpoint.bin";
-
-/// What a life writes in its folder (removed when a new life starts there, so that a folder
-/// never mixes two lives).
-const OUTPUTS: [&str; 6] = [
-    "life.csv",
-    "life.json",
-    "scars.csv",
-    "life.png",
-    "convergence.csv",
-    "convergence.png",
-];
 
 /// Options of `fretdyn life`.
 pub struct Options {

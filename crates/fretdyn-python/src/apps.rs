@@ -9,33 +9,15 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use fretdyn::apps::life::{LifeCheckpoint, LifeControl, LifeSettings};
+use fretdyn::apps::life::{
+    CHECKPOINT_FILE, LIFE_RUN_FILE, LifeCheckpoint, LifeControl, LifeSettings, MAX_HALVINGS,
+    OUTPUTS,
+};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::{Case, FretdynError, err};
-
-/// The file that records the inputs of a life's folder, for `resume` (the CLI's name).
-const LIFE_RUN_FILE: &str = "life_run.json";
-
-/// The checkpoint of a life (the CLI's name).
-const CHECKPOINT_FILE: &str = "life_checkpoint.bin";
-
-/// What a life writes in its folder: removed when a new life starts there, so that a folder
-/// never mixes two lives (the CLI's list; `life.csv`, `scars.csv`, `convergence.csv` are
-/// written by the Python package).
-const OUTPUTS: [&str; 6] = [
-    "life.csv",
-    "life.json",
-    "scars.csv",
-    "life.png",
-    "convergence.csv",
-    "convergence.png",
-];
-
-/// Most halvings of `halvings` (`fretdyn life --halvings`: each about doubles the life steps).
-const MAX_HALVINGS: u32 = 10;
 
 /// Runs `work` on a thread of its own while this thread waits with the GIL released and looks
 /// for Ctrl-C every 50 ms: on Ctrl-C (or any pending signal's exception) `work`'s stop flag

@@ -728,6 +728,27 @@ pub fn service_life(
     service_life_with(case, life, &mut LifeControl::default(), observer)
 }
 
+/// Most halvings of `max_depth_change` a convergence check runs (`fretdyn life --halvings`,
+/// Python's `halvings`): each about doubles the life steps of the one before.
+pub const MAX_HALVINGS: u32 = 10;
+
+/// The file that records which inputs a life's folder belongs to, for a resume.
+pub const LIFE_RUN_FILE: &str = "life_run.json";
+
+/// The checkpoint of a life in its folder ([`LifeCheckpoint`]).
+pub const CHECKPOINT_FILE: &str = "life_checkpoint.bin";
+
+/// What a life writes in its folder (removed when a new life starts there, so that a folder
+/// never mixes two lives).
+pub const OUTPUTS: [&str; 6] = [
+    "life.csv",
+    "life.json",
+    "scars.csv",
+    "life.png",
+    "convergence.csv",
+    "convergence.png",
+];
+
 /// The text of `life.json`, as `fretdyn life` and Python's `fretdyn.life` write it: the case
 /// `title`, the plugging `criterion_depth` (m, or null) and the `results`.
 pub fn life_json(title: &str, results: &LifeResults, criterion: Option<f64>) -> String {
