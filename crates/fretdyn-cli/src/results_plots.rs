@@ -64,7 +64,7 @@ struct Histories {
 }
 
 fn read_histories(dir: &Path) -> Result<Histories, String> {
-    let npz = dir.join(fretdyn::results::stream::RESULTS_FILE);
+    let npz = dir.join(fretdyn::output::stream::RESULTS_FILE);
     if npz.exists() {
         let file = std::fs::File::open(&npz).map_err(|e| format!("{}: {e}", npz.display()))?;
         let mut z = NpzReader::new(file).map_err(|e| format!("{}: {e}", npz.display()))?;
@@ -83,7 +83,7 @@ fn read_histories(dir: &Path) -> Result<Histories, String> {
         })
     } else {
         // a run stopped before its end: the streamed series
-        let series = dir.join(fretdyn::results::stream::SERIES_DIR);
+        let series = dir.join(fretdyn::output::stream::SERIES_DIR);
         fn npy<A: ReadNpyExt>(dir: &Path, key: &str) -> Result<A, String> {
             let p = dir.join(format!("{key}.npy"));
             let f = std::fs::File::open(&p).map_err(|e| format!("{}: {e}", p.display()))?;
@@ -101,7 +101,7 @@ fn read_histories(dir: &Path) -> Result<Histories, String> {
 /// Peak forces of the impacts, per contact index, from `impacts.csv`.
 fn read_peaks(dir: &Path, contacts: usize) -> Vec<Vec<f64>> {
     let mut peaks = vec![Vec::new(); contacts];
-    if let Ok(text) = std::fs::read_to_string(dir.join(fretdyn::results::stream::IMPACTS_FILE)) {
+    if let Ok(text) = std::fs::read_to_string(dir.join(fretdyn::output::stream::IMPACTS_FILE)) {
         for line in text.lines().skip(1) {
             let cols: Vec<&str> = line.split(',').collect();
             if let (Some(Ok(k)), Some(Ok(p))) = (

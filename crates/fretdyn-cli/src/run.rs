@@ -1,7 +1,7 @@
 //! `fretdyn run`: one case file, or the built-in demo; `fretdyn run --resume DIR` continues a
 //! run that was interrupted; `fretdyn plot DIR` redraws a run's plots.
 //!
-//! Every run is streamed to its folder ([`fretdyn::results::stream`]): time histories flushed chunk by
+//! Every run is streamed to its folder ([`fretdyn::output::stream`]): time histories flushed chunk by
 //! chunk, impacts as they end, a checkpoint every `checkpoint_seconds` and on Ctrl-C or
 //! SIGTERM, so that a killed run leaves readable results and can be resumed, giving the
 //! results of an uninterrupted run bit for bit. A run holds a lock on its folder: a second
@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
 use fretdyn::integrator::simulation::{Progress, RunResults, Termination};
-use fretdyn::results::stream::{ResultsMetadata, StreamObserver, StreamSettings};
+use fretdyn::output::stream::{ResultsMetadata, StreamObserver, StreamSettings};
 use ndarray::{Array3, Ix3};
 use ndarray_npy::NpzReader;
 use serde_json::json;
@@ -110,11 +110,11 @@ pub fn check_start(case: &Case, path: &Path) -> Result<(), Failure> {
 }
 
 /// The time histories a streamed run writes, bytes: its samples (`steps / output.every + 1`)
-/// times [`fretdyn::results::recorder::Recorder::bytes_per_sample`], plus the headers of the files.
+/// times [`fretdyn::accumulate::recorder::Recorder::bytes_per_sample`], plus the headers of the files.
 fn series_bytes(case: &Case) -> u64 {
     let s = &case.settings;
     let samples = (s.steps / s.output_every.max(1)).saturating_add(1);
-    let per_sample = fretdyn::results::recorder::Recorder::bytes_per_sample(
+    let per_sample = fretdyn::accumulate::recorder::Recorder::bytes_per_sample(
         case.model.basis.modes(),
         case.model.contacts.len(),
     );
@@ -146,7 +146,7 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
         return Ok(());
     };
     let needed = series_bytes(case);
-    let size = fretdyn::results::recorder::human_bytes;
+    let size = fretdyn::accumulate::recorder::human_bytes;
     let verdict = disk_verdict(needed, needed, free);
     if verdict == DiskVerdict::SeriesShort {
         let raise = needed.div_ceil(free.max(1) / 2 + 1).max(2);
@@ -179,9 +179,9 @@ fn check_disk_to_resume(case: &Case, dir: &Path) -> Result<(), Failure> {
         return Ok(());
     };
     let total = series_bytes(case);
-    let written = folder_bytes(&dir.join(fretdyn::results::stream::SERIES_DIR));
+    let written = folder_bytes(&dir.join(fretdyn::output::stream::SERIES_DIR));
     let remaining = total.saturating_sub(written);
-    let size = fretdyn::results::recorder::human_bytes;
+    let size = fretdyn::accumulate::recorder::human_bytes;
     match disk_verdict(remaining, total, free) {
         DiskVerdict::Fits => Ok(()),
         // every time history written: the packing starts at once, and says itself what
@@ -267,7 +267,7 @@ fn resume_run(dir: &Path, options: &Options) -> Result<(), Failure> {
         })?;
     let path = PathBuf::from(info["case_file"].as_str().unwrap_or_default());
     let _lock = crate::folder::lock(dir, "run")?;
-    if !dir.join(fretdyn::results::stream::CHECKPOINT_FILE).exists() {
+    if !dir.join(fretdyn::output::stream::CHECKPOINT_FILE).exists() {
         return Err(Failure::input(format!(
             "{}: the run stopped before its first checkpoint, there is nothing to resume; start it again: fretdyn run {} -o {}",
             dir.display(),
@@ -350,9 +350,9 @@ impl StreamObserver for Observer<'_> {
 /// Writes `summary.json` and the same per-contact statistics as a table, `contacts.csv`
 /// (with `contacts_columns.csv`, their units and Code_Aster names); returns the summary's path.
 fn write_summary(case: &Case, results: &RunResults, dir: &Path) -> fretdyn::Result<PathBuf> {
-    let summary = fretdyn::results::output::summary(case, results);
-    let path = fretdyn::results::output::write_summary(dir, &summary)?;
-    fretdyn::results::contacts_table::write_contacts_csv(dir, &summary)?;
+    let summary = fretdyn::output::summary::summary(case, results);
+    let path = fretdyn::output::summary::write_summary(dir, &summary)?;
+    fretdyn::output::contacts_table::write_contacts_csv(dir, &summary)?;
     Ok(path)
 }
 
@@ -381,7 +381,7 @@ pub fn run_and_write(
         summary: None,
     };
     let results = if resume {
-        fretdyn::results::stream::resume(
+        fretdyn::output::stream::resume(
             &case.model,
             &case.settings,
             dir,
@@ -390,7 +390,7 @@ pub fn run_and_write(
             &mut observer,
         )
     } else {
-        fretdyn::results::stream::run(
+        fretdyn::output::stream::run(
             &case.model,
             &case.settings,
             dir,
@@ -405,7 +405,7 @@ pub fn run_and_write(
             // a failed run (a full disk): what was written up to the last checkpoint stays
             fretdyn::Error::Io { .. } => Failure::failed(format!(
                 "{source}: {e}{}",
-                if dir.join(fretdyn::results::stream::CHECKPOINT_FILE).exists() {
+                if dir.join(fretdyn::output::stream::CHECKPOINT_FILE).exists() {
                     format!(
                         "; once fixed (room on the disk), continue the run with: fretdyn run --resume {}",
                         dir.display()
@@ -463,9 +463,10 @@ pub fn run_and_write(
 pub fn error_warnings(case: &Case, r: &RunResults) -> Vec<String> {
     let st = &case.settings.statistics;
     // the energy balance's error (THEORY §5): a time step too coarse
-    let mut out = fretdyn::results::energy::energy_warnings(&r.energy, r.dt);
-    let stationary =
-        |c: &&fretdyn::results::statistics::ContactStatistics| c.impacts >= c.errors.batches.max(2);
+    let mut out = fretdyn::accumulate::energy::energy_warnings(&r.energy, r.dt);
+    let stationary = |c: &&fretdyn::accumulate::statistics::ContactStatistics| {
+        c.impacts >= c.errors.batches.max(2)
+    };
     let correlated: Vec<String> = r
         .contacts
         .iter()
@@ -520,7 +521,7 @@ fn number(x: f64) -> String {
 
 /// Reads `t` and `contact_tangential_force` of a finished run.
 fn read_friction(dir: &Path) -> Result<(Vec<f64>, Array3<f64>), Failure> {
-    let path = dir.join(fretdyn::results::stream::RESULTS_FILE);
+    let path = dir.join(fretdyn::output::stream::RESULTS_FILE);
     let err = |e: &dyn std::fmt::Display| Failure::failed(format!("{}: {e}", path.display()));
     let file = std::fs::File::open(&path).map_err(|e| err(&e))?;
     let mut npz = NpzReader::new(file).map_err(|e| err(&e))?;
@@ -619,7 +620,7 @@ fn demo(options: &Options) -> Result<(), Failure> {
         let slug = label.split_whitespace().next().unwrap_or("run").to_string();
         let case = v1.case(&format!("V1a {label}"), method);
         let sub = dir.join(&slug);
-        let fingerprint = fretdyn::results::stream::fnv1a(case.title.as_bytes());
+        let fingerprint = fretdyn::output::stream::fnv1a(case.title.as_bytes());
         let _lock = crate::folder::lock(&sub, "run")?;
         run_and_write(&case, "demo", None, &sub, options, fingerprint, false)?;
         let (t, f) = read_friction(&sub)?;

@@ -257,7 +257,7 @@ fn modes_prints_the_table_and_writes_basis_and_picture() {
 
 /// Step of the last checkpoint in a run folder, if there is one.
 fn checkpoint_step(dir: &Path) -> Option<u64> {
-    fretdyn::results::stream::checkpoint_step(dir).ok()
+    fretdyn::output::stream::checkpoint_step(dir).ok()
 }
 
 fn npz_f64(dir: &Path, key: &str) -> ndarray::ArrayD<f64> {
@@ -1217,7 +1217,7 @@ fn a_run_reports_its_standard_errors_and_warns_when_they_are_large() {
     let mut some_warned = false;
     for c in summary["contacts"].as_array().unwrap() {
         assert_eq!(c["batches"], 20);
-        for key in fretdyn::results::statistics::BATCHED_STATISTICS {
+        for key in fretdyn::accumulate::statistics::BATCHED_STATISTICS {
             let se = c[format!("{key}_se")].as_f64();
             assert!(se.is_some_and(|e| e >= 0.0), "{key}_se of {}", c["name"]);
         }

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use fretdyn::results::contacts_table::{COLUMNS, LEFT_OUT};
+use fretdyn::output::contacts_table::{COLUMNS, LEFT_OUT};
 
 mod common;
 use common::{Scratch, examples};

@@ -72,7 +72,7 @@ fn read_nc(path: &Path) -> Nc {
     use netcdf::types::{FloatType, IntType, NcVariableType};
     // the HDF5 library prints an error stack for each attribute libnetcdf probes and does
     // not find, in every test thread but the first (hundreds of "HDF5-DIAG: Error" blocks)
-    fretdyn::results::netcdf::quiet_hdf5_errors();
+    fretdyn::output::netcdf::quiet_hdf5_errors();
     let file = netcdf::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut vars = BTreeMap::new();
     for v in file.variables() {
@@ -305,12 +305,12 @@ fn results_nc_has_the_arrays_of_results_npz_with_names_and_units() {
 
     // the names, dimensions, units and long names are those of the one table the Python
     // package's to_xarray() takes them from, and nothing else
-    let table = fretdyn::results::variables::time_histories(true);
+    let table = fretdyn::output::variables::time_histories(true);
     let described: Vec<(&str, &[&str], Option<&str>, &str)> = table
         .iter()
         .map(|h| &h.variable)
         .chain(
-            fretdyn::results::variables::COORDINATES
+            fretdyn::output::variables::COORDINATES
                 .iter()
                 .map(|c| &c.variable),
         )

@@ -357,7 +357,7 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
     let c = &case.inner;
     let s = &c.settings;
     let samples = (s.steps / s.output_every.max(1)).saturating_add(1);
-    fretdyn::results::recorder::Recorder::check_memory(
+    fretdyn::accumulate::recorder::Recorder::check_memory(
         samples,
         c.model.basis.modes(),
         c.model.contacts.len(),
@@ -426,7 +426,7 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
         "contact_status",
         PyArray1::from_vec(py, status).reshape(r.status.shape().to_vec())?,
     )?;
-    let summary = fretdyn::results::output::summary(c, &results);
+    let summary = fretdyn::output::summary::summary(c, &results);
     out.set_item("summary_json", summary.to_string())?;
     let names: Vec<String> = c.model.contacts.iter().map(|k| k.name.clone()).collect();
     out.set_item("impacts", impacts(py, &results.impacts, &names)?)?;
@@ -440,13 +440,13 @@ fn run<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
     Ok(out)
 }
 
-/// The columns of `impacts.csv` (`fretdyn::results::stream`) of `impacts`.
+/// The columns of `impacts.csv` (`fretdyn::output::stream`) of `impacts`.
 fn impacts<'py>(
     py: Python<'py>,
-    impacts: &[fretdyn::results::statistics::Impact],
+    impacts: &[fretdyn::accumulate::statistics::Impact],
     names: &[String],
 ) -> PyResult<Bound<'py, PyDict>> {
-    use fretdyn::results::statistics::Impact;
+    use fretdyn::accumulate::statistics::Impact;
     let out = PyDict::new(py);
     let contact: Vec<i64> = impacts.iter().map(|i| i.contact as i64).collect();
     out.set_item("contact", PyArray1::from_vec(py, contact))?;
@@ -481,13 +481,13 @@ fn impacts<'py>(
     Ok(out)
 }
 
-/// The columns of `blocks.csv` (`fretdyn::results::stream`) of `blocks`.
+/// The columns of `blocks.csv` (`fretdyn::output::stream`) of `blocks`.
 fn blocks<'py>(
     py: Python<'py>,
-    blocks: &[fretdyn::results::statistics::BlockStatistics],
+    blocks: &[fretdyn::accumulate::statistics::BlockStatistics],
     names: &[String],
 ) -> PyResult<Bound<'py, PyDict>> {
-    use fretdyn::results::statistics::ContactStatistics;
+    use fretdyn::accumulate::statistics::ContactStatistics;
     let out = PyDict::new(py);
     let block: Vec<i64> = blocks.iter().map(|b| b.block as i64).collect();
     out.set_item("block", PyArray1::from_vec(py, block))?;
@@ -533,11 +533,11 @@ fn blocks<'py>(
     Ok(out)
 }
 
-/// A variable of `fretdyn::results::variables` as a dict: `name`, `dims`, `units` (None for
+/// A variable of `fretdyn::output::variables` as a dict: `name`, `dims`, `units` (None for
 /// names), `long_name`, `flag_meanings`.
 fn variable_dict<'py>(
     py: Python<'py>,
-    v: &fretdyn::results::variables::Variable,
+    v: &fretdyn::output::variables::Variable,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("name", v.name)?;
@@ -548,7 +548,7 @@ fn variable_dict<'py>(
     Ok(d)
 }
 
-/// The one table of names, dimensions, units and long names (`fretdyn::results::variables`,
+/// The one table of names, dimensions, units and long names (`fretdyn::output::variables`,
 /// which `results.nc` is written from): the time histories of a run of a modal model
 /// (`modal`) or of one in physical coordinates, in the order of `results.npz`, each a dict
 /// with `key` (of `results.npz`), `name`, `dims`, `units`, `long_name`, `flag_meanings` and
@@ -560,7 +560,7 @@ fn variables<'py>(
     py: Python<'py>,
     modal: bool,
 ) -> PyResult<(Bound<'py, PyList>, Bound<'py, PyList>)> {
-    use fretdyn::results::variables::{COORDINATES, auxiliary_coordinates, time_histories};
+    use fretdyn::output::variables::{COORDINATES, auxiliary_coordinates, time_histories};
     let histories = PyList::empty(py);
     for h in time_histories(modal) {
         let d = variable_dict(py, &h.variable)?;
@@ -581,7 +581,7 @@ fn variables<'py>(
 /// whether the case's model is modal (else in physical coordinates).
 #[pyfunction]
 fn coordinates<'py>(py: Python<'py>, case: &Case) -> PyResult<(Bound<'py, PyDict>, bool)> {
-    use fretdyn::results::variables::{COORDINATES, Labels, Values};
+    use fretdyn::output::variables::{COORDINATES, Labels, Values};
     let labels = Labels::of(&case.inner.model);
     let out = PyDict::new(py);
     for c in &COORDINATES {
@@ -820,7 +820,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(case_with, m)?)?;
     m.add_function(wrap_pyfunction!(variables, m)?)?;
     m.add_function(wrap_pyfunction!(coordinates, m)?)?;
-    m.add("RESULTS_COMMENT", fretdyn::results::variables::COMMENT)?;
+    m.add("RESULTS_COMMENT", fretdyn::output::variables::COMMENT)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(apps::life, m)?)?;

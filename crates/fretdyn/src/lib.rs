@@ -43,21 +43,25 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 // The stages, in the order of the data flow (not alphabetical: keep it so).
-pub mod case;
-
 pub mod structure;
 
 pub mod loads;
 
 pub mod contact;
 
+pub mod wear;
+
 pub mod model;
+
+pub mod settings;
+
+pub mod accumulate;
 
 pub mod integrator;
 
-pub mod results;
+pub mod case;
 
-pub mod wear;
+pub mod output;
 
 pub mod apps;
 

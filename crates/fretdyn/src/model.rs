@@ -3,6 +3,8 @@
 //! the [`Model`] the integrator steps — modal basis, contacts, loads and initial state,
 //! everything a run needs except the numerical settings (THEORY §1, §2).
 
+use nalgebra::DMatrix;
+
 use crate::contact::Contact;
 use crate::error::{Error, Result};
 use crate::loads::{BaseAcceleration, ModalLoad, PointLoad};
@@ -240,5 +242,29 @@ impl Model {
         self.initial.q = q.iter().copied().collect();
         self.initial.qdot = qd.iter().copied().collect();
         Ok(())
+    }
+}
+
+/// The tube's reference model in physical coordinates: here, not in [`crate::structure::tube`],
+/// because it builds a [`Model`] (the structure layer is below the model).
+impl crate::structure::tube::TubeStructure {
+    /// The same finite elements in physical coordinates with Rayleigh damping
+    /// `C = α M + β K` — the reference solver of the tests (small models only: dense).
+    pub fn physical_model(&self, alpha: f64, beta: f64) -> Result<Model> {
+        let assembled = self.beam.assemble()?;
+        let n = assembled.mass.nrows();
+        let points = self.named_points(&assembled, &DMatrix::<f64>::identity(n, n));
+        let damping = &assembled.mass * alpha + &assembled.stiffness * beta;
+        let participation: Vec<f64> = assembled.base_inertia.iter().copied().collect();
+        let mut model = Model::physical(
+            PhysicalMatrices {
+                mass: assembled.mass,
+                damping,
+                stiffness: assembled.stiffness,
+            },
+            points,
+        );
+        model.basis.participation = participation;
+        Ok(model)
     }
 }

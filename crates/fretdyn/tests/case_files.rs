@@ -8,11 +8,11 @@ use common::TempDir;
 use std::path::Path;
 
 use fretdyn::Error;
+use fretdyn::accumulate::recorder::Recorder;
 use fretdyn::apps::verification::V1;
 use fretdyn::case::Case;
 use fretdyn::contact::tangential::{GaussSeidelSettings, TangentialMethod};
 use fretdyn::integrator::simulation::simulate;
-use fretdyn::results::recorder::Recorder;
 
 /// V1a (THEORY §6) as a case file. The incoming velocity is written with Rust's shortest
 /// round-trip formatting of the same expressions `V1::model` evaluates, so it is exact.

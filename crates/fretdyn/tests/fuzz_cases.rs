@@ -84,7 +84,7 @@ fn check(text: String, base: PathBuf) -> Outcome {
     if rec.position.iter().any(|x| !x.is_finite()) {
         bad.push("results.position".into());
     }
-    let summary = fretdyn::results::output::summary(&case, &results);
+    let summary = fretdyn::output::summary::summary(&case, &results);
     // a model without stiffness (free masses, no contact) has no stability limit: its
     // `stable_dt` is ∞, written as null
     let unbounded = results.stable_dt == f64::INFINITY;

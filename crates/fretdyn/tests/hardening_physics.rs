@@ -15,6 +15,7 @@ use std::f64::consts::{PI, TAU};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
+use fretdyn::accumulate::statistics::StatisticsSettings;
 use fretdyn::case::Case;
 use fretdyn::contact::friction::Coulomb;
 use fretdyn::contact::motion::Motion;
@@ -26,8 +27,7 @@ use fretdyn::contact::{Contact, NormalLaw};
 use fretdyn::integrator::simulation::{RunResults, RunSettings, Termination, simulate};
 use fretdyn::loads::{PointLoad, TimeHistory};
 use fretdyn::model::Model;
-use fretdyn::results::statistics::StatisticsSettings;
-use fretdyn::results::stream::{self, ProgressOnly, StreamSettings};
+use fretdyn::output::stream::{self, ProgressOnly, StreamSettings};
 use fretdyn::structure::modal::ModalBasis;
 use nalgebra::Vector3;
 
@@ -512,7 +512,7 @@ every = 1
             assert_eq!(contact.as_deref(), culprit, "{label} {how}");
             assert_eq!(*time, *step as f64 * case.settings.dt, "{label} {how}");
             assert_eq!(r.steps, step - 1, "{label} {how}: the steps kept");
-            let summary = fretdyn::results::output::summary(&case, r);
+            let summary = fretdyn::output::summary::summary(&case, r);
             let mut nulls = Vec::new();
             find_nulls(&summary, "summary", &mut nulls);
             // the one null allowed: no contact to name

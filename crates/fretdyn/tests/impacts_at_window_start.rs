@@ -8,6 +8,7 @@
 
 use std::f64::consts::TAU;
 
+use fretdyn::accumulate::statistics::StatisticsSettings;
 use fretdyn::contact::friction::Coulomb;
 use fretdyn::contact::obstacle::{Obstacle, Plane};
 use fretdyn::contact::tangential::{
@@ -16,7 +17,6 @@ use fretdyn::contact::tangential::{
 use fretdyn::contact::{Contact, NormalLaw};
 use fretdyn::integrator::simulation::{RunResults, RunSettings, simulate};
 use fretdyn::model::Model;
-use fretdyn::results::statistics::StatisticsSettings;
 use fretdyn::structure::modal::{ModalBasis, Point};
 use nalgebra::Vector3;
 

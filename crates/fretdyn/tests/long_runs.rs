@@ -5,10 +5,10 @@
 use std::ops::ControlFlow;
 use std::path::Path;
 
+use fretdyn::accumulate::statistics::StatisticsSettings;
 use fretdyn::case::Case;
 use fretdyn::integrator::simulation::{Progress, RunResults, Termination, simulate};
-use fretdyn::results::statistics::StatisticsSettings;
-use fretdyn::results::stream::{self, ProgressOnly, StreamObserver, StreamSettings};
+use fretdyn::output::stream::{self, ProgressOnly, StreamObserver, StreamSettings};
 use ndarray::{ArrayD, IxDyn};
 use ndarray_npy::NpzReader;
 

@@ -8,10 +8,10 @@ use std::cell::Cell;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use fretdyn::accumulate::recorder::Recorder;
 use fretdyn::apps::study::{Combine, Study};
 use fretdyn::case::Case;
 use fretdyn::integrator::simulation::simulate;
-use fretdyn::results::recorder::Recorder;
 
 struct Counting;
 

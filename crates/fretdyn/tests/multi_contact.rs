@@ -5,6 +5,7 @@
 
 use std::ops::ControlFlow;
 
+use fretdyn::accumulate::statistics::ContactStatistics;
 use fretdyn::apps::benchmark::rattling_tube;
 use fretdyn::contact::delassus::{Slot, TangentialProblem};
 use fretdyn::contact::friction::Slide;
@@ -14,7 +15,6 @@ use fretdyn::contact::tangential::{
     TangentialMethod, gauss_seidel,
 };
 use fretdyn::integrator::simulation::{RunResults, Termination, run, simulate};
-use fretdyn::results::statistics::ContactStatistics;
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
 // ---------------------------------------------------------------------------------------------

@@ -19,6 +19,7 @@
 //!    the plane is at rest, and slides at `μ_d N` as soon as the plane moves (the Active Set
 //!    starts that step from a stick, which its stick solve must refuse).
 
+use fretdyn::accumulate::statistics::StatisticsSettings;
 use fretdyn::contact::friction::{Coulomb, LocalSolve};
 use fretdyn::contact::motion::Motion;
 use fretdyn::contact::obstacle::{Obstacle, Plane};
@@ -29,7 +30,6 @@ use fretdyn::contact::{Contact, NormalLaw};
 use fretdyn::integrator::simulation::{RunSettings, simulate};
 use fretdyn::loads::{PointLoad, TimeHistory};
 use fretdyn::model::Model;
-use fretdyn::results::statistics::StatisticsSettings;
 use fretdyn::structure::modal::{ModalBasis, Point};
 use nalgebra::Vector3;
 

@@ -12,10 +12,10 @@
 use std::ops::ControlFlow;
 use std::path::Path;
 
+use fretdyn::accumulate::statistics::ContactStatistics;
 use fretdyn::case::Case;
 use fretdyn::integrator::simulation::{Termination, simulate};
-use fretdyn::results::statistics::ContactStatistics;
-use fretdyn::results::stream::{self, ProgressOnly, StreamSettings};
+use fretdyn::output::stream::{self, ProgressOnly, StreamSettings};
 
 const CASE: &str = r#"
 title = "Tube tip rattling in a hole under white-noise turbulence"

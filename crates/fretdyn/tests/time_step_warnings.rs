@@ -7,6 +7,7 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
+use fretdyn::accumulate::energy::{MAX_RELATIVE_ERROR, energy_time_step, energy_warnings};
 use fretdyn::case::Case;
 use fretdyn::contact::friction::Coulomb;
 use fretdyn::contact::obstacle::{Circle, Obstacle, Plane};
@@ -17,7 +18,6 @@ use fretdyn::integrator::stability::{
     MIN_STEPS_PER_IMPACT, impact_resolution, impact_resolution_warnings, impact_time_step,
 };
 use fretdyn::model::Model;
-use fretdyn::results::energy::{MAX_RELATIVE_ERROR, energy_time_step, energy_warnings};
 use fretdyn::structure::modal::{ModalBasis, Point};
 use nalgebra::Vector3;
 

@@ -841,7 +841,7 @@ fn summary_gives_the_volume_rates_at_the_run_wear_work_rate() {
     let results = fretdyn::simulate(&case.model, &case.settings).unwrap();
     let w = results.contacts[0].wear_work_rate;
     assert!(w > 0.0, "the mass slides on the plane");
-    let summary = fretdyn::results::output::summary(&case, &results);
+    let summary = fretdyn::output::summary::summary(&case, &results);
     let c = &summary["contacts"][0];
     assert_eq!(c["tube_volume_rate"].as_f64().unwrap(), 20e-15 * w);
     assert_eq!(c["support_volume_rate"].as_f64().unwrap(), 10e-15 * w);
@@ -850,7 +850,7 @@ fn summary_gives_the_volume_rates_at_the_run_wear_work_rate() {
     let plain =
         parse(&case_with(PLANE, "", BAR_WEAR).replace(&format!("wear = {BAR_WEAR}"), "")).unwrap();
     let results = fretdyn::simulate(&plain.model, &plain.settings).unwrap();
-    let summary = fretdyn::results::output::summary(&plain, &results);
+    let summary = fretdyn::output::summary::summary(&plain, &results);
     assert!(summary["contacts"][0].get("tube_volume_rate").is_none());
 }
 

@@ -5,6 +5,7 @@
 
 use std::f64::consts::TAU;
 
+use fretdyn::accumulate::statistics::StatisticsSettings;
 use fretdyn::contact::friction::Coulomb;
 use fretdyn::contact::motion::Motion;
 use fretdyn::contact::obstacle::{Obstacle, Plane};
@@ -15,7 +16,6 @@ use fretdyn::contact::{Contact, NormalLaw};
 use fretdyn::integrator::simulation::{RunResults, RunSettings, simulate};
 use fretdyn::loads::{PointLoad, TimeHistory};
 use fretdyn::model::Model;
-use fretdyn::results::statistics::StatisticsSettings;
 use fretdyn::structure::modal::{ModalBasis, Point};
 use nalgebra::Vector3;
 

@@ -42,11 +42,9 @@
 
 use std::collections::BTreeSet;
 use std::io::Write;
-use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
 
 use serde::Deserialize;
 
@@ -57,9 +55,8 @@ use crate::case::key_path::{KeyPath, KeyPathError, Missing, Part};
 use crate::case::{Case, check_case_text, named_file, parse_error};
 use crate::error::{Error, Result};
 use crate::files::Lock;
-use crate::integrator::simulation::{RunResults, RunSettings, Simulation, Termination};
-use crate::model::Model;
-use crate::results::wear_map::WearMap;
+use crate::integrator::simulation::{RunResults, Simulation, Termination};
+pub use crate::integrator::simulation::{statistics_run, statistics_run_until};
 
 /// How the parameters' values are combined into runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -263,7 +260,7 @@ pub const TABLE_STATISTICS: [&str; 10] = [
 pub fn table_errors() -> impl Iterator<Item = &'static str> {
     TABLE_STATISTICS
         .into_iter()
-        .filter(|s| crate::results::statistics::BATCHED_STATISTICS.contains(s))
+        .filter(|s| crate::accumulate::statistics::BATCHED_STATISTICS.contains(s))
 }
 
 impl Study {
@@ -1454,74 +1451,6 @@ pub fn connors_exceedance(table: &Path) -> Result<Option<ConnorsExceedance>> {
 /// [`crate::integrator::simulation::simulate`] (running sums, which do not depend on what is recorded).
 pub fn run_statistics(case: &Case) -> Result<RunResults> {
     statistics_run(&case.model, &case.settings, None).map(|(results, _)| results)
-}
-
-/// [`run_statistics`] of `model` with `settings`; with `wear_bins`, also where each contact's
-/// wear work was done ([`WearMap`] with that many bins around a hole, THEORY §14.3).
-pub fn statistics_run(
-    model: &Model,
-    settings: &RunSettings,
-    wear_bins: Option<usize>,
-) -> Result<(RunResults, Option<WearMap>)> {
-    statistics_run_until(model, settings, wear_bins, None)
-}
-
-/// [`statistics_run`] that stops at the end of a batch of steps once `stop` is set
-/// ([`Termination::Stopped`]).
-pub fn statistics_run_until(
-    model: &Model,
-    settings: &RunSettings,
-    wear_bins: Option<usize>,
-    stop: Option<&AtomicBool>,
-) -> Result<(RunResults, Option<WearMap>)> {
-    let mut sim = Simulation::with_recorder(model, settings, 1)?;
-    if let Some(bins) = wear_bins {
-        sim.track_wear(bins);
-    }
-    statistics_run_from(sim, settings, &mut |sim| {
-        if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-            ControlFlow::Break(sim.steps_done())
-        } else {
-            ControlFlow::Continue(())
-        }
-    })
-}
-
-/// The loop of [`statistics_run`] from a simulation made (or resumed) by the caller:
-/// `at_batch(sim)` after every batch of steps before the last; `Break(step)` stops the run
-/// there ([`Termination::Stopped`]).
-pub fn statistics_run_from(
-    mut sim: Simulation,
-    settings: &RunSettings,
-    at_batch: &mut dyn FnMut(&Simulation) -> ControlFlow<u64>,
-) -> Result<(RunResults, Option<WearMap>)> {
-    let start = Instant::now();
-    let model = sim.model();
-    let total = settings.steps;
-    let mut termination = Termination::Completed;
-    while sim.steps_done() < total {
-        // to the end of the batch, where the finished impacts and blocks are let go
-        if let Err(d) = sim.steps(sim.steps_to_batch_end(total)) {
-            termination = d.into_termination(model);
-            break;
-        }
-        if sim.recorder().is_full() {
-            sim.recorder_mut().clear();
-        }
-        if sim.steps_done().is_multiple_of(Simulation::BATCH) {
-            let statistics = sim.statistics_mut();
-            statistics.impacts.clear();
-            statistics.blocks.clear();
-            if sim.steps_done() < total
-                && let ControlFlow::Break(step) = at_batch(&sim)
-            {
-                termination = Termination::Stopped { step };
-                break;
-            }
-        }
-    }
-    let map = sim.wear_map().cloned();
-    Ok((sim.finish(start.elapsed().as_secs_f64(), termination), map))
 }
 
 fn csv_value(v: &toml::Value) -> String {

@@ -3,8 +3,8 @@
 use serde::Deserialize;
 
 use super::TubeModel;
-use crate::apps::life::{DEFAULT_MAX_DEPTH_CHANGE, LifeSettings, YEAR};
 use crate::error::{Error, Result};
+use crate::settings::life::{DEFAULT_MAX_DEPTH_CHANGE, LifeSettings, YEAR};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

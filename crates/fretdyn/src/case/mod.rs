@@ -73,7 +73,7 @@ pub struct Case {
     /// them as `s_<name>`.
     pub point_abscissae: Vec<Option<f64>>,
     /// The `[life]` section: the service life (THEORY §14.5), for `fretdyn life`.
-    pub life: Option<crate::apps::life::LifeSettings>,
+    pub life: Option<crate::settings::life::LifeSettings>,
 }
 
 impl Case {

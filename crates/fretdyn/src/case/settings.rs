@@ -4,6 +4,7 @@
 use serde::Deserialize;
 
 use super::CaseFile;
+use crate::accumulate::statistics::StatisticsSettings;
 use crate::contact::friction::LocalSolve;
 use crate::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
@@ -12,7 +13,6 @@ use crate::error::{Error, Result, number};
 use crate::integrator::simulation::RunSettings;
 use crate::integrator::stability::checked_stable_time_step;
 use crate::model::Model;
-use crate::results::statistics::StatisticsSettings;
 
 /// `[statistics]`: the window, blocks (batches), standard errors and their target, impact
 /// definition and wear coefficient (THEORY §5).
@@ -49,7 +49,7 @@ impl Default for StatisticsSection {
 }
 
 fn default_max_relative_error() -> f64 {
-    crate::results::statistics::DEFAULT_MAX_RELATIVE_ERROR
+    crate::accumulate::statistics::DEFAULT_MAX_RELATIVE_ERROR
 }
 
 #[derive(Debug, Deserialize)]
@@ -323,7 +323,7 @@ impl CaseFile {
                     "{} s is longer than the statistics window ({} s): the standard errors need several batches in it; set block ≤ a tenth of the window or leave it out ({} batches by default)",
                     number(block),
                     number(window),
-                    crate::results::statistics::DEFAULT_BATCHES
+                    crate::accumulate::statistics::DEFAULT_BATCHES
                 ),
             ));
         }

@@ -490,7 +490,7 @@ pub fn impact_time_step(model: &Model) -> Option<f64> {
         .iter()
         .map(|r| r.duration)
         .reduce(f64::min)?;
-    Some(crate::results::energy::round_down(
+    Some(crate::accumulate::energy::round_down(
         shortest / MIN_STEPS_PER_IMPACT,
         |dt| shortest / dt >= MIN_STEPS_PER_IMPACT,
     ))

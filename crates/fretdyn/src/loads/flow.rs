@@ -28,6 +28,7 @@ use crate::loads::fluid_elastic::{FlowNode, FluidElastic, QuasiSteady, ReducedVe
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, number};
+pub use crate::structure::line::Station;
 use crate::structure::modal::ModalBasis;
 
 /// Tube bundle pattern (the angle between the flow and the pitch lines).
@@ -173,35 +174,6 @@ impl VelocityProfile {
                 Ok(())
             }
         }
-    }
-}
-
-/// A quadrature point along the tube.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Station {
-    /// Abscissa along the tube, m.
-    pub s: f64,
-    /// Quadrature weight, m (`Σ w = ` the length covered).
-    pub weight: f64,
-    /// Translation rows of the tube's axis there, row-major 3 × p (as [`crate::structure::modal::Point::rows`]).
-    pub rows: Vec<f64>,
-    /// Unit tangent of the tube's axis (zero when unknown: then the whole translation counts
-    /// as transverse).
-    pub tangent: Vector3<f64>,
-}
-
-impl Station {
-    /// Translation of mode `i` at the station.
-    pub fn translation(&self, i: usize) -> Vector3<f64> {
-        let p = self.rows.len() / 3;
-        Vector3::new(self.rows[i], self.rows[p + i], self.rows[2 * p + i])
-    }
-
-    /// `|u − (u·t) t|²` of mode `i`: the squared displacement normal to the axis.
-    pub fn transverse_square(&self, i: usize) -> f64 {
-        let u = self.translation(i);
-        let t = self.tangent;
-        (u - t * u.dot(&t)).norm_squared()
     }
 }
 

@@ -17,19 +17,7 @@
 use nalgebra::DMatrix;
 
 use crate::error::{Error, Result};
-
-/// One element of a beam mesh, or the part of it that a line load covers: the load on
-/// `loaded = [s0, s1]` goes to the end nodes through the linear shape functions of the element
-/// `ends = [s_a, s_b]`, `N_a(s) = (s_b − s)/(s_b − s_a)`, `N_b(s) = (s − s_a)/(s_b − s_a)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LineCell {
-    /// Rows of the end nodes `a`, `b` in the covariance matrix.
-    pub nodes: [usize; 2],
-    /// Abscissae `s_a < s_b` of the end nodes along the tube, m.
-    pub ends: [f64; 2],
-    /// The loaded part `[s0, s1]`, `s_a ≤ s0 < s1 ≤ s_b`, m.
-    pub loaded: [f64; 2],
-}
+pub use crate::structure::line::LineCell;
 
 /// Kernel `exp(−|s − s'|/λ)` below `exp(−CUTOFF)` (4e-18) is left out.
 const CUTOFF: f64 = 40.0;

@@ -7,10 +7,12 @@
 //! - [`beam`]: Euler–Bernoulli/Timoshenko beam finite elements, assembled;
 //! - [`tube`]: a tube line on supports, meshed with [`beam`] elements and reduced on its lowest
 //!   modes by [`eigen`];
-//! - [`eigen`]: the generalised symmetric eigenproblem `K φ = ω² M φ`.
+//! - [`eigen`]: the generalised symmetric eigenproblem `K φ = ω² M φ`;
+//! - [`line`]: stations and cells along a tube, where line loads and flow forces meet its modes.
 
 pub mod basis_file;
 pub mod beam;
 pub mod eigen;
+pub mod line;
 pub mod modal;
 pub mod tube;

@@ -10,11 +10,9 @@
 use nalgebra::{DMatrix, Vector3};
 
 use crate::error::{Error, Result, number};
-use crate::loads::flow::Station;
-use crate::loads::spatial_correlation::LineCell;
-use crate::model::{Model, PhysicalMatrices};
 use crate::structure::beam::{Assembled, BeamModel, Dof, Mesh};
 use crate::structure::eigen::{ModeSelection, Modes, lowest_modes};
+use crate::structure::line::{LineCell, Station};
 use crate::structure::modal::{ModalBasis, Point};
 
 /// A named point of the tube: a node, and an offset from the axis.
@@ -147,31 +145,11 @@ impl TubeStructure {
             modes,
         })
     }
-
-    /// The same finite elements in physical coordinates with Rayleigh damping
-    /// `C = α M + β K` — the reference solver of the tests (small models only: dense).
-    pub fn physical_model(&self, alpha: f64, beta: f64) -> Result<Model> {
-        let assembled = self.beam.assemble()?;
-        let n = assembled.mass.nrows();
-        let points = self.named_points(&assembled, &DMatrix::<f64>::identity(n, n));
-        let damping = &assembled.mass * alpha + &assembled.stiffness * beta;
-        let participation: Vec<f64> = assembled.base_inertia.iter().copied().collect();
-        let mut model = Model::physical(
-            PhysicalMatrices {
-                mass: assembled.mass,
-                damping,
-                stiffness: assembled.stiffness,
-            },
-            points,
-        );
-        model.basis.participation = participation;
-        Ok(model)
-    }
 }
 
 impl TubeStructure {
     /// The named points with their rows taken from `shapes` (n × p, over the reduced DOFs).
-    fn named_points(&self, assembled: &Assembled, shapes: &DMatrix<f64>) -> Vec<Point> {
+    pub(crate) fn named_points(&self, assembled: &Assembled, shapes: &DMatrix<f64>) -> Vec<Point> {
         self.points
             .iter()
             .map(|pt| Point {

@@ -53,27 +53,6 @@ pub enum WearWork {
     Normal,
 }
 
-impl WearWork {
-    /// The rate of a contact's statistics this work is.
-    pub fn rate(self, statistics: &crate::results::statistics::ContactStatistics) -> f64 {
-        match self {
-            WearWork::Friction => statistics.wear_work_rate,
-            WearWork::Normal => statistics.normal_wear_work_rate,
-        }
-    }
-
-    /// Its standard error by batch means (THEORY §11), when there are batches.
-    pub fn rate_se(
-        self,
-        statistics: &crate::results::statistics::ContactStatistics,
-    ) -> Option<f64> {
-        match self {
-            WearWork::Friction => statistics.errors.wear_work_rate_se,
-            WearWork::Normal => statistics.errors.normal_wear_work_rate_se,
-        }
-    }
-}
-
 impl ContactWear {
     /// Checks the laws and the geometry; `field` names the contact's `wear` table.
     pub fn validate(&self, field: &str) -> Result<()> {

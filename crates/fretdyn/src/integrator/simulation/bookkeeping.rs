@@ -3,11 +3,11 @@
 
 use super::contact_kinds::ContactKinds;
 use super::{ContactState, RunResults, Simulation, Termination};
+use crate::accumulate::recorder::{ContactSample, Recorder};
+use crate::accumulate::statistics::{ContactStep, StepValues};
 use crate::contact::frame_rows::FrameRows;
 use crate::contact::friction::Slide;
 use crate::kernels::Lanes;
-use crate::results::recorder::{ContactSample, Recorder};
-use crate::results::statistics::{ContactStep, StepValues};
 use crate::structure::modal::recombine;
 
 impl Simulation<'_> {
@@ -155,7 +155,7 @@ impl Simulation<'_> {
             .finish(&self.settings.statistics, &self.names, dt);
         self.energy.settle();
         let mut blocks = std::mem::take(&mut self.statistics.blocks);
-        crate::results::statistics::name_blocks(&mut blocks, &self.names);
+        crate::accumulate::statistics::name_blocks(&mut blocks, &self.names);
         RunResults {
             target_met_at: self.statistics.target_met(),
             contacts,

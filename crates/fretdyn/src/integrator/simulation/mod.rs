@@ -18,20 +18,27 @@ mod contact_kinds;
 mod detection;
 mod normal;
 mod run;
-mod settings;
+
 mod tangential;
 
-pub use run::{Divergence, Progress, RunResults, Termination, run, simulate};
-pub use settings::RunSettings;
+pub use crate::settings::RunSettings;
+pub use run::{
+    Divergence, Progress, RunResults, Termination, run, simulate, statistics_run,
+    statistics_run_from, statistics_run_until,
+};
 
+use crate::settings::run::round_down;
 use bookkeeping::{contact_step, step_values};
 use contact_kinds::{AnyContacts, CommonContacts, ContactKinds};
-use settings::round_down;
 use tangential::{LagrangeSolver, Tangential};
 
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
+use crate::accumulate::energy::{EnergyBalance, EnergyRaw};
+use crate::accumulate::recorder::Recorder;
+use crate::accumulate::statistics::ContactStatisticsState;
+use crate::accumulate::wear_map::WearMap;
 use crate::contact::frame_rows::FrameRows;
 use crate::contact::friction::Slide;
 use crate::contact::obstacle::ContactFrame;
@@ -45,10 +52,6 @@ use crate::kernels::{Lanes, PaddedRows, Portable};
 use crate::loads::fluid_elastic::{DelayHistory, FluidElasticForce};
 use crate::loads::stepped::SteppedHistory;
 use crate::model::Model;
-use crate::results::energy::{EnergyBalance, EnergyRaw};
-use crate::results::recorder::Recorder;
-use crate::results::statistics::ContactStatisticsState;
-use crate::results::wear_map::WearMap;
 use crate::structure::modal::project_add;
 
 /// Everything that the steps after step `step` depend on: a run restored from it continues

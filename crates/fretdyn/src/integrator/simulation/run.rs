@@ -6,12 +6,14 @@ use std::ops::ControlFlow;
 use serde::Serialize;
 
 use super::{RunSettings, Simulation};
+use crate::accumulate::energy::EnergyBalance;
+use crate::accumulate::recorder::Recorder;
+use crate::accumulate::statistics::{BlockStatistics, ContactStatistics, Impact};
+use crate::accumulate::wear_map::WearMap;
 use crate::contact::tangential::SolverStatistics;
 use crate::error::Result;
 use crate::model::Model;
-use crate::results::energy::EnergyBalance;
-use crate::results::recorder::Recorder;
-use crate::results::statistics::{BlockStatistics, ContactStatistics, Impact};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Progress report passed to the observer of [`run`].
@@ -147,4 +149,72 @@ impl Divergence {
             contact: self.contact.map(|c| model.contacts[c].name.clone()),
         }
     }
+}
+
+/// A run of `model` with `settings` for its statistics only ([`crate::apps::study::run_statistics`]); with `wear_bins`, also where each contact's
+/// wear work was done ([`WearMap`] with that many bins around a hole, THEORY §14.3).
+pub fn statistics_run(
+    model: &Model,
+    settings: &RunSettings,
+    wear_bins: Option<usize>,
+) -> Result<(RunResults, Option<WearMap>)> {
+    statistics_run_until(model, settings, wear_bins, None)
+}
+
+/// [`statistics_run`] that stops at the end of a batch of steps once `stop` is set
+/// ([`Termination::Stopped`]).
+pub fn statistics_run_until(
+    model: &Model,
+    settings: &RunSettings,
+    wear_bins: Option<usize>,
+    stop: Option<&AtomicBool>,
+) -> Result<(RunResults, Option<WearMap>)> {
+    let mut sim = Simulation::with_recorder(model, settings, 1)?;
+    if let Some(bins) = wear_bins {
+        sim.track_wear(bins);
+    }
+    statistics_run_from(sim, settings, &mut |sim| {
+        if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            ControlFlow::Break(sim.steps_done())
+        } else {
+            ControlFlow::Continue(())
+        }
+    })
+}
+
+/// The loop of [`statistics_run`] from a simulation made (or resumed) by the caller:
+/// `at_batch(sim)` after every batch of steps before the last; `Break(step)` stops the run
+/// there ([`Termination::Stopped`]).
+pub fn statistics_run_from(
+    mut sim: Simulation,
+    settings: &RunSettings,
+    at_batch: &mut dyn FnMut(&Simulation) -> ControlFlow<u64>,
+) -> Result<(RunResults, Option<WearMap>)> {
+    let start = Instant::now();
+    let model = sim.model();
+    let total = settings.steps;
+    let mut termination = Termination::Completed;
+    while sim.steps_done() < total {
+        // to the end of the batch, where the finished impacts and blocks are let go
+        if let Err(d) = sim.steps(sim.steps_to_batch_end(total)) {
+            termination = d.into_termination(model);
+            break;
+        }
+        if sim.recorder().is_full() {
+            sim.recorder_mut().clear();
+        }
+        if sim.steps_done().is_multiple_of(Simulation::BATCH) {
+            let statistics = sim.statistics_mut();
+            statistics.impacts.clear();
+            statistics.blocks.clear();
+            if sim.steps_done() < total
+                && let ControlFlow::Break(step) = at_batch(&sim)
+            {
+                termination = Termination::Stopped { step };
+                break;
+            }
+        }
+    }
+    let map = sim.wear_map().cloned();
+    Ok((sim.finish(start.elapsed().as_secs_f64(), termination), map))
 }

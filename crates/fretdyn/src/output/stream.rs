@@ -3,7 +3,7 @@
 //! bit, to those of an uninterrupted run.
 //!
 //! A streamed run writes in its folder:
-//! - `series/<key>.npy`: one `.npy` file per time history of [`crate::results::recorder::Recorder`]
+//! - `series/<key>.npy`: one `.npy` file per time history of [`crate::accumulate::recorder::Recorder`]
 //!   (keys of `results.npz`), appended chunk by chunk; the header, rewritten after each
 //!   append, always gives the number of rows completely written, so that `numpy.load` reads
 //!   what a killed run had flushed;
@@ -36,13 +36,18 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use crate::accumulate::recorder::Recorder;
+use crate::accumulate::statistics::{BlockStatistics, Impact};
 use crate::error::{Error, Result};
 use crate::integrator::simulation::{
     Progress, RunResults, RunSettings, Simulation, Snapshot, Termination,
 };
 use crate::model::Model;
-use crate::results::recorder::Recorder;
-use crate::results::statistics::{BlockStatistics, Impact};
+pub use crate::output::layout::{
+    BLOCKS_FILE, CHECKPOINT_FILE, IMPACTS_FILE, NETCDF_FILE, RESULTS_FILE, ResultsMetadata,
+    SERIES_DIR,
+};
+use crate::output::layout::{Dtype, NPY_HEADER};
 
 /// How a streamed run writes and checkpoints.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,18 +90,6 @@ pub trait StreamObserver {
     }
 }
 
-/// The global attributes of `results.nc` that the library does not know: a front end gives
-/// them through [`StreamObserver::metadata`]. Without the `netcdf` feature, not used.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ResultsMetadata {
-    /// The case's title.
-    pub title: Option<String>,
-    /// The text of the case file (TOML).
-    pub case_toml: Option<String>,
-    /// The text of `summary.json`.
-    pub summary_json: Option<String>,
-}
-
 /// An observer that only reports progress through a closure.
 pub struct ProgressOnly<F>(pub F);
 
@@ -105,15 +98,6 @@ impl<F: FnMut(Progress) -> ControlFlow<()>> StreamObserver for ProgressOnly<F> {
         (self.0)(progress)
     }
 }
-
-/// File names in a run folder.
-pub const SERIES_DIR: &str = "series";
-pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
-pub const IMPACTS_FILE: &str = "impacts.csv";
-pub const BLOCKS_FILE: &str = "blocks.csv";
-pub const RESULTS_FILE: &str = "results.npz";
-/// `results.nc`, written with the `netcdf` feature (`results/netcdf.rs`).
-pub const NETCDF_FILE: &str = "results.nc";
 
 /// The files a complete run has packed from `series/`.
 fn packed_files() -> &'static [&'static str] {
@@ -421,7 +405,7 @@ struct Files {
     model_contacts: Vec<String>,
     /// The names and units of `results.nc`.
     #[cfg(feature = "netcdf")]
-    labels: crate::results::variables::Labels,
+    labels: crate::output::variables::Labels,
 }
 
 impl Files {
@@ -452,7 +436,7 @@ impl Files {
             blocks,
             model_contacts: model.contacts.iter().map(|c| c.name.clone()).collect(),
             #[cfg(feature = "netcdf")]
-            labels: crate::results::variables::Labels::of(model),
+            labels: crate::output::variables::Labels::of(model),
         };
         files.sync()?;
         Ok(files)
@@ -484,7 +468,7 @@ impl Files {
             blocks: reopen_at(&dir.join(BLOCKS_FILE), blocks_bytes)?,
             model_contacts: model.contacts.iter().map(|c| c.name.clone()).collect(),
             #[cfg(feature = "netcdf")]
-            labels: crate::results::variables::Labels::of(model),
+            labels: crate::output::variables::Labels::of(model),
         })
     }
 
@@ -652,10 +636,10 @@ impl Files {
         })?;
         #[cfg(feature = "netcdf")]
         {
-            let series: Vec<crate::results::netcdf::SeriesFile> = self
+            let series: Vec<crate::output::netcdf::SeriesFile> = self
                 .series
                 .iter()
-                .map(|s| crate::results::netcdf::SeriesFile {
+                .map(|s| crate::output::netcdf::SeriesFile {
                     key: &s.key,
                     path: &s.path,
                     dtype: s.dtype,
@@ -663,7 +647,7 @@ impl Files {
                     rows: s.rows,
                 })
                 .collect();
-            crate::results::netcdf::write(&self.dir, &series, &self.labels, meta)?;
+            crate::output::netcdf::write(&self.dir, &series, &self.labels, meta)?;
         }
         #[cfg(not(feature = "netcdf"))]
         let _ = meta;
@@ -757,32 +741,6 @@ fn reopen_at(path: &Path, len: u64) -> Result<BufWriter<File>> {
     file.seek(SeekFrom::Start(len)).map_err(io)?;
     Ok(BufWriter::new(file))
 }
-
-/// Element type of a series.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Dtype {
-    F64,
-    I8,
-}
-
-impl Dtype {
-    fn descr(self) -> &'static str {
-        match self {
-            Dtype::F64 => "<f8",
-            Dtype::I8 => "|i1",
-        }
-    }
-
-    pub(crate) fn size(self) -> u64 {
-        match self {
-            Dtype::F64 => 8,
-            Dtype::I8 => 1,
-        }
-    }
-}
-
-/// Header room of the `.npy` files: fixed, so that the row count can be rewritten in place.
-pub(crate) const NPY_HEADER: usize = 256;
 
 /// A `.npy` file (format 1.0) that grows by rows.
 struct NpyAppender {

@@ -1,7 +1,7 @@
 //! The one table of names, dimensions, units and long names of a run's time histories (the
 //! keys of `results.npz`, THEORY §5) and of the coordinates along their dimensions. Every
 //! self-describing output takes its metadata from here, and nowhere else: `results.nc`
-//! (`crate::results::netcdf`), the Python package's `Result.to_xarray()` and its plot labels
+//! (`crate::output::netcdf`), the Python package's `Result.to_xarray()` and its plot labels
 //! (`fretdyn.variables()`). `xarray.open_dataset("results.nc")` and `to_xarray()` are then the
 //! same Dataset.
 //!
@@ -122,7 +122,7 @@ const TC: &[&str] = &[TIME, CONTACT];
 const TCT: &[&str] = &[TIME, CONTACT, TANGENT];
 
 /// The time histories in modal coordinates, in the order of `results.npz`
-/// ([`crate::results::output::write_results_npz`]).
+/// ([`crate::output::summary::write_results_npz`]).
 const MODAL: [TimeHistory; 9] = [
     history("t", v(TIME, &[TIME], Some("s"), "time")),
     history(
@@ -456,7 +456,7 @@ impl Labels {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::results::recorder::Recorder;
+    use crate::accumulate::recorder::Recorder;
 
     /// The multi-span tube: 30 modes, 5 contacts in holes, 6 named points.
     fn tube() -> Model {

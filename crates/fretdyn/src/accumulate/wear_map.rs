@@ -6,10 +6,10 @@
 //! a plane, one bin. The service life ([`crate::apps::life`]) spreads a contact's wear volume
 //! with it. Off by default; the closed contacts of a step only when on.
 
+use crate::accumulate::statistics::StepValues;
 use crate::contact::obstacle::Obstacle;
 use crate::contact::scar::AngularProfile;
 use crate::model::Model;
-use crate::results::statistics::StepValues;
 
 /// Friction work and normal work per contact and bin, J.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]

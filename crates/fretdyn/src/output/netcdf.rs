@@ -2,7 +2,7 @@
 //! (THEORY §5), which `xarray.open_dataset`, `ncdump -h` or HDFView read without the README:
 //!
 //! - the dimensions, variables and coordinates of the one table
-//!   [`crate::results::variables`], with its names, `units` (UDUNITS) and `long_name` (CF
+//!   [`crate::output::variables`], with its names, `units` (UDUNITS) and `long_name` (CF
 //!   `flag_values`/`flag_meanings` for `contact_status`), and nothing of its own: `time`
 //!   (unlimited; the `t` of `results.npz`), `mode`, `contact`, `tangent` (t1, t2),
 //!   `local_axis` (e1, e2), `point`, `direction` (x, y, z); the auxiliary coordinates in the
@@ -19,7 +19,7 @@
 //!
 //! # When it is written, and why then
 //!
-//! At the end of a streamed run ([`crate::results::stream`]), just after `results.npz` and in
+//! At the end of a streamed run ([`crate::output::stream`]), just after `results.npz` and in
 //! the same way: packed from the streamed `series/<key>.npy`, read back a block of rows at a
 //! time (at most [`READ_BYTES`] of one series in memory), appended along `time`. The step loop
 //! is untouched and memory does not grow with the run's length. Appending to `results.nc`
@@ -48,14 +48,14 @@ use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
-use crate::results::stream::{Dtype, NPY_HEADER, ResultsMetadata};
-use crate::results::variables::{self, COORDINATES, TIME, Values, Variable};
+use crate::output::layout::{Dtype, NPY_HEADER, ResultsMetadata};
+use crate::output::variables::{self, COORDINATES, TIME, Values, Variable};
 
 /// The names and reference values that label the arrays (see [`variables::Labels`]).
-pub use crate::results::variables::Labels;
+pub use crate::output::variables::Labels;
 
 /// The file name in a run folder.
-pub use crate::results::stream::NETCDF_FILE;
+pub use crate::output::layout::NETCDF_FILE;
 
 /// Bytes of one series read at a time while packing.
 pub const READ_BYTES: usize = 4 << 20;
@@ -63,7 +63,7 @@ pub const READ_BYTES: usize = 4 << 20;
 /// Bytes of an HDF5 chunk along `time` (at most; fewer for a short run).
 const CHUNK_BYTES: usize = 1 << 20;
 
-/// One streamed series (`series/<key>.npy`, written by [`crate::results::stream`]): a
+/// One streamed series (`series/<key>.npy`, written by [`crate::output::stream`]): a
 /// fixed [`NPY_HEADER`]-byte header, then `rows` rows of `row_shape` little-endian values.
 pub(crate) struct SeriesFile<'a> {
     pub key: &'a str,
@@ -153,7 +153,7 @@ fn disk_full(e: std::io::Error, dir: &Path) -> std::io::Error {
             _ => return e,
         }
     };
-    // results.npz is packed first (crate::results::stream): it and the series stay
+    // results.npz is packed first (crate::output::stream): it and the series stay
     std::io::Error::new(
         full.kind(),
         format!("{full}: results.npz and the time histories in series/ stay written"),
@@ -422,7 +422,7 @@ mod tests {
     use nalgebra::DMatrix;
 
     use crate::model::{Coordinates, PhysicalMatrices};
-    use crate::results::stream::{self, ProgressOnly, StreamSettings};
+    use crate::output::stream::{self, ProgressOnly, StreamSettings};
 
     /// The units of `q` and `q̇` follow the model's coordinates: the V1a point mass (1 kg, so
     /// `Φ = I`) run in modal coordinates, then in physical ones (`M = I`, `C = K = 0`: the

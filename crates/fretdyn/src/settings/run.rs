@@ -4,7 +4,7 @@ use serde::Serialize;
 
 use crate::contact::tangential::{StickVelocity, TangentialMethod};
 use crate::error::{Error, Result};
-use crate::results::statistics::StatisticsSettings;
+use crate::settings::statistics::StatisticsSettings;
 
 /// Numerical settings of a run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -99,7 +99,7 @@ fn check_gs(g: &crate::contact::tangential::GaussSeidelSettings, field: &str) ->
 }
 
 /// `x` rounded down to 3 significant digits, for the time step suggested to the user.
-pub(super) fn round_down(x: f64) -> f64 {
+pub(crate) fn round_down(x: f64) -> f64 {
     if !(x.is_finite() && x > 0.0) {
         return x;
     }

@@ -14,11 +14,11 @@ use crate::error::Result;
 use crate::files::write_atomically;
 use crate::integrator::simulation::RunResults;
 
-/// Writes `results.npz` in `dir` with the arrays of [`crate::results::recorder::Recorder`]:
+/// Writes `results.npz` in `dir` with the arrays of [`crate::accumulate::recorder::Recorder`]:
 /// `t`, `q`, `qdot`, `contact_normal_force`, `contact_tangential_force`,
 /// `contact_slip_velocity`, `contact_penetration`, `contact_status`, `contact_position`
 /// (contact names are in `summary.json`, in the same order). A streamed run
-/// ([`crate::results::stream`]) writes the same keys.
+/// ([`crate::output::stream`]) writes the same keys.
 pub fn write_results_npz(dir: &Path, results: &RunResults) -> Result<PathBuf> {
     let r = &results.recorder;
     let path = dir.join("results.npz");

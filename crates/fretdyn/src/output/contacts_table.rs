@@ -57,7 +57,7 @@ const fn column(
 }
 
 /// The columns of `contacts.csv`, in order: the contact's index and name, then the fields of
-/// [`crate::results::statistics::ContactStatistics`], the wear volume rates of a contact with
+/// [`crate::accumulate::statistics::ContactStatistics`], the wear volume rates of a contact with
 /// `wear`, and the standard errors by batch means with their batches (THEORY §5).
 pub const COLUMNS: &[Column] = &[
     column(
