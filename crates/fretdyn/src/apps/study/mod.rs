@@ -39,6 +39,11 @@
 //! The runs are: every combination of the `values` parameters (grid or list) × every sample ×
 //! every seed, in that order; percentiles ([`percentiles`](crate::apps::percentiles)) pool the
 //! samples and seeds of a combination.
+//!
+//! Files, lowest first: `table` the columns and rows of `study.csv`; `file` the study file
+//! read and checked; `runs` the list of runs, each run's case and its row; `execute` the
+//! pending runs into the table (checked, locked, continued, in parallel); `report` the
+//! percentiles and the Connors check of a finished table.
 
 mod execute;
 mod file;
