@@ -5,18 +5,17 @@
 //! The library computes ([`fretdyn::apps::life::service_life`]); this prints and writes.
 
 use crate::run::significant;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use fretdyn::apps::life::{
-    LifeCheckpoint, LifeControl, LifeEnd, LifeResults, LifeStep, YEAR, service_life_with,
+    CHECKPOINT_FILE, LifeCheckpoint, LifeControl, LifeEnd, LifeResults, LifeStep, Unresumable,
+    YEAR, convergence_csv, end_depths, service_life_with,
 };
 use fretdyn::case::Case;
 use fretdyn::error::number;
 
 use crate::Failure;
 pub use fretdyn::apps::life::MAX_HALVINGS;
-use fretdyn::apps::life::{CHECKPOINT_FILE, LIFE_RUN_FILE, OUTPUTS};
 
 use crate::out::{errln, outln};
 use crate::plot::{self, Layout, Mark, Panel, Series, YScale};
@@ -66,7 +65,8 @@ pub fn main(o: &Options) -> Result<(), Failure> {
     let resume = match &o.resume {
         Some(_) => Some(read_checkpoint(&dir, &path, fingerprint)?),
         None => {
-            start_afresh(&dir, &path, fingerprint)?;
+            fretdyn::apps::life::start_afresh(&dir, fingerprint, Some(&path))
+                .map_err(|e| Failure::failed(e.to_string()))?;
             None
         }
     };
@@ -140,15 +140,14 @@ pub fn main(o: &Options) -> Result<(), Failure> {
         e => Failure::input(e.in_file(&path)),
     })?;
     printed?;
-    write(&dir, &case.title, &results, life.criterion).map_err(|e| {
+    fretdyn::apps::life::write_life(&dir, &case.title, &results, life.criterion).map_err(|e| {
         if checkpoint.exists() {
             Failure::failed(format!(
-                "{}; the life is kept in its checkpoint: once there is room on the disk, write its results with: fretdyn life --resume {}",
-                e.message,
+                "{e}; the life is kept in its checkpoint: once there is room on the disk, write its results with: fretdyn life --resume {}",
                 dir.display()
             ))
         } else {
-            e
+            Failure::failed(e.to_string())
         }
     })?;
     if o.plots {
@@ -251,75 +250,43 @@ pub fn default_dir(case: &Path) -> PathBuf {
 
 /// The case file of the life in `dir` (`life_run.json`), for `--resume`.
 fn recorded_case(dir: &Path) -> Result<PathBuf, Failure> {
-    let run_file = dir.join(LIFE_RUN_FILE);
-    let info: serde_json::Value = std::fs::read_to_string(&run_file)
-        .map_err(|e| e.to_string())
-        .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+    fretdyn::apps::life::recorded_case_file(dir)
+        .map(Option::unwrap_or_default)
         .map_err(|e| {
             Failure::input(format!(
-                "{}: {e} (--resume needs a folder written by fretdyn life CASE)",
-                run_file.display()
+                "{e} (--resume needs a folder written by fretdyn life CASE)"
             ))
-        })?;
-    Ok(PathBuf::from(
-        info["case_file"].as_str().unwrap_or_default(),
-    ))
+        })
 }
 
 /// The checkpoint to resume the life in `dir` from: refused when the case (or a file it
 /// reads) changed since the life started, or when there is none.
 fn read_checkpoint(dir: &Path, path: &Path, fingerprint: u64) -> Result<LifeCheckpoint, Failure> {
-    let info: serde_json::Value = std::fs::read_to_string(dir.join(LIFE_RUN_FILE))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok())
-        .unwrap_or_default();
-    if info["fingerprint"].as_str() != Some(fingerprint.to_string().as_str()) {
-        return Err(Failure::input(format!(
-            "{}: the case file or a file it reads changed since the life in {} started; start the life again instead of resuming it: fretdyn life {} -o {}",
-            path.display(),
-            dir.display(),
-            path.display(),
-            dir.display()
-        )));
-    }
-    let checkpoint = dir.join(CHECKPOINT_FILE);
-    if !checkpoint.exists() {
-        return Err(Failure::input(format!(
-            "{}: no checkpoint to resume: the life there is over (life.json says how it ended) or stopped before its first checkpoint; start it again: fretdyn life {} -o {}",
-            dir.display(),
-            path.display(),
-            dir.display()
-        )));
-    }
-    let c = LifeCheckpoint::read(&checkpoint).map_err(|e| Failure::input(e.to_string()))?;
-    if c.fingerprint() != fingerprint {
-        return Err(Failure::input(format!(
-            "{}: written for other inputs than {} has now; start the life again: fretdyn life {} -o {}",
-            checkpoint.display(),
-            path.display(),
-            path.display(),
-            dir.display()
-        )));
-    }
-    Ok(c)
-}
-
-/// A new life in `dir`: the files of an earlier life there are removed, and the case it
-/// belongs to recorded (`life_run.json`).
-fn start_afresh(dir: &Path, path: &Path, fingerprint: u64) -> Result<(), Failure> {
-    for name in OUTPUTS.iter().chain(&[CHECKPOINT_FILE]) {
-        let p = dir.join(name);
-        match std::fs::remove_file(&p) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(Failure::failed(format!("{}: {e}", p.display())));
-            }
-            _ => {}
-        }
-    }
-    let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-    let info = serde_json::json!({ "case_file": absolute, "fingerprint": fingerprint.to_string() });
-    fretdyn::files::write_text_atomically(&dir.join(LIFE_RUN_FILE), &format!("{info:#}\n"))
-        .map_err(|e| Failure::failed(e.to_string()))
+    fretdyn::apps::life::resume_checkpoint(dir, fingerprint).map_err(|why| {
+        Failure::input(match why {
+            Unresumable::Changed => format!(
+                "{}: the case file or a file it reads changed since the life in {} started; start the life again instead of resuming it: fretdyn life {} -o {}",
+                path.display(),
+                dir.display(),
+                path.display(),
+                dir.display()
+            ),
+            Unresumable::NoCheckpoint => format!(
+                "{}: no checkpoint to resume: the life there is over (life.json says how it ended) or stopped before its first checkpoint; start it again: fretdyn life {} -o {}",
+                dir.display(),
+                path.display(),
+                dir.display()
+            ),
+            Unresumable::OtherInputs(checkpoint) => format!(
+                "{}: written for other inputs than {} has now; start the life again: fretdyn life {} -o {}",
+                checkpoint.display(),
+                path.display(),
+                path.display(),
+                dir.display()
+            ),
+            Unresumable::Unreadable(e) => e.to_string(),
+        })
+    })
 }
 
 /// A service time in a message: in years, or in seconds when below a hundredth of a year.
@@ -378,19 +345,8 @@ fn convergence(
         fractions.push(refined.max_depth_change);
         lives.push(r);
     }
-    let mut csv = String::from("max_depth_change,life_steps,life_end,end_years");
-    for name in &first.contacts {
-        let _ = write!(csv, ",{name}.tube_depth");
-    }
-    csv.push('\n');
-    for (f, r) in fractions.iter().zip(&lives) {
-        let end = r.steps.last().map_or(0.0, |s| s.time) / YEAR;
-        let _ = write!(csv, "{f:e},{},{},{end:e}", r.steps.len() - 1, r.end.name());
-        for x in end_depths(r) {
-            let _ = write!(csv, ",{x:e}");
-        }
-        csv.push('\n');
-    }
+    let rows: Vec<(f64, &LifeResults)> = fractions.iter().copied().zip(&lives).collect();
+    let csv = convergence_csv(&first.contacts, &rows);
     let p = dir.join("convergence.csv");
     if let Err(e) = fretdyn::files::write_text_atomically(&p, &csv) {
         return Ok(Err(Failure::failed(e.to_string())));
@@ -476,78 +432,6 @@ fn unconverged(names: &[String], before: &[f64], after: &[f64]) -> Option<String
     })
 }
 
-/// Each contact's tube depth at the end of a life.
-fn end_depths(r: &LifeResults) -> Vec<f64> {
-    r.steps
-        .last()
-        .map(|s| s.contacts.iter().map(|c| c.tube_depth).collect())
-        .unwrap_or_default()
-}
-
-/// Writes `life.csv`, `scars.csv` and `life.json`, each to a temporary name then renamed
-/// (a full disk never leaves a truncated table under its final name).
-fn write(dir: &Path, title: &str, r: &LifeResults, criterion: Option<f64>) -> Result<(), Failure> {
-    let put = |name: &str, text: String| {
-        fretdyn::files::write_text_atomically(&dir.join(name), &text)
-            .map_err(|e| Failure::failed(e.to_string()))
-    };
-    let mut csv = String::from("time_years");
-    for name in &r.contacts {
-        for col in [
-            "wear_work_rate",
-            "wear_work_rate_se",
-            "tube_volume",
-            "support_volume",
-            "tube_depth",
-            "support_depth",
-            "clearance_increase",
-            "tube_depth_fixed_gap",
-        ] {
-            let _ = write!(csv, ",{name}.{col}");
-        }
-    }
-    csv.push('\n');
-    for s in &r.steps {
-        let _ = write!(csv, "{:e}", s.time / YEAR);
-        for c in &s.contacts {
-            let se = c
-                .wear_work_rate_se
-                .map(|x| format!("{x:e}"))
-                .unwrap_or_default();
-            let _ = write!(
-                csv,
-                ",{:e},{se},{:e},{:e},{:e},{:e},{:e},{:e}",
-                c.wear_work_rate,
-                c.tube_volume,
-                c.support_volume,
-                c.tube_depth,
-                c.support_depth,
-                c.clearance_increase,
-                c.tube_depth_fixed_gap
-            );
-        }
-        csv.push('\n');
-    }
-    put("life.csv", csv)?;
-    let mut scars = String::from("contact,kind,bin,angle_deg,clearance_increase,tube_depth\n");
-    for s in &r.scars {
-        let n = s.clearance_increase.len();
-        for (b, (a, t)) in s.clearance_increase.iter().zip(&s.tube_depth).enumerate() {
-            let angle = if s.kind == "hole" {
-                format!("{}", (b as f64 + 0.5) * 360.0 / n as f64)
-            } else {
-                String::new()
-            };
-            let _ = writeln!(scars, "{},{},{b},{angle},{a:e},{t:e}", s.contact, s.kind);
-        }
-    }
-    put("scars.csv", scars)?;
-    put(
-        "life.json",
-        fretdyn::apps::life::life_json(title, r, criterion),
-    )
-}
-
 /// A life's table as `life.csv` gives it, per contact: the tube depth with the scars fed back
 /// and at fixed gap, the wear work rate of each window and its standard error.
 pub struct LifeTable {
@@ -605,34 +489,15 @@ impl LifeTable {
         })
     }
 
-    /// The standard error of each depth of contact `k`: the depth gained over each life step
-    /// is the window's wear work rate times the step, so its relative error is the rate's
-    /// (SE/rate of the window that opened the step); windows are independent runs, so the
-    /// errors of the steps add in quadrature. At fixed gap every step has the first window's
-    /// rate: its relative error throughout.
+    /// The first-order standard error of each depth of contact `k`, with the scars fed back
+    /// and at fixed gap ([`fretdyn::apps::life::depth_standard_errors`]).
     pub fn depth_se(&self, k: usize) -> (Vec<f64>, Vec<f64>) {
-        let relative = |i: usize| {
-            let (r, se) = (self.rate[k][i], self.rate_se[k][i]);
-            if r > 0.0 && se.is_finite() {
-                se / r
-            } else {
-                0.0
-            }
-        };
-        let mut coupled = vec![0.0; self.years.len()];
-        let mut sum = 0.0;
-        for (i, se) in coupled.iter_mut().enumerate().skip(1) {
-            let gained = self.depth[k][i] - self.depth[k][i - 1];
-            sum += (gained * relative(i - 1)).powi(2);
-            *se = sum.sqrt();
-        }
-        // the first window's: the first row with a rate and its error
-        let first = (0..self.years.len())
-            .map(relative)
-            .find(|r| *r > 0.0)
-            .unwrap_or(0.0);
-        let fixed = self.fixed[k].iter().map(|d| d * first).collect();
-        (coupled, fixed)
+        fretdyn::apps::life::depth_standard_errors(
+            &self.depth[k],
+            &self.fixed[k],
+            &self.rate[k],
+            &self.rate_se[k],
+        )
     }
 }
 

@@ -10,8 +10,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use fretdyn::apps::life::{
-    CHECKPOINT_FILE, LIFE_RUN_FILE, LifeCheckpoint, LifeControl, LifeSettings, MAX_HALVINGS,
-    OUTPUTS,
+    CHECKPOINT_FILE, LifeCheckpoint, LifeControl, LifeResults, LifeSettings, MAX_HALVINGS,
+    Unresumable,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -75,31 +75,6 @@ fn lock_folder(dir: &Path) -> PyResult<fretdyn::files::Lock> {
     }
 }
 
-/// A new life in `dir`: the folder made, the files of an earlier life there removed, and the
-/// fingerprint of its inputs recorded (`life_run.json`), with the case file when the case is
-/// one as it is on disk (then `fretdyn life --resume DIR` continues it too).
-fn start_afresh(dir: &Path, fingerprint: u64, case_file: Option<&Path>) -> PyResult<()> {
-    std::fs::create_dir_all(dir).map_err(|e| {
-        FretdynError::new_err(format!("{}: cannot create the folder: {e}", dir.display()))
-    })?;
-    for name in OUTPUTS.iter().chain(&[CHECKPOINT_FILE]) {
-        let p = dir.join(name);
-        match std::fs::remove_file(&p) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(FretdynError::new_err(format!("{}: {e}", p.display())));
-            }
-            _ => {}
-        }
-    }
-    let mut info = serde_json::json!({ "fingerprint": fingerprint.to_string() });
-    if let Some(path) = case_file {
-        let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-        info["case_file"] = serde_json::json!(absolute);
-    }
-    fretdyn::files::write_text_atomically(&dir.join(LIFE_RUN_FILE), &format!("{info:#}\n"))
-        .map_err(err)
-}
-
 /// The checkpoint to continue the life in `dir` from: refused when the inputs changed since
 /// the life started there, or when there is none (the CLI's checks, in Python's words).
 fn read_checkpoint(dir: &Path, fingerprint: u64) -> PyResult<LifeCheckpoint> {
@@ -107,31 +82,72 @@ fn read_checkpoint(dir: &Path, fingerprint: u64) -> PyResult<LifeCheckpoint> {
         "start the life again: fretdyn.life(case, output={:?})",
         dir.display().to_string()
     );
-    let info: serde_json::Value = std::fs::read_to_string(dir.join(LIFE_RUN_FILE))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok())
-        .unwrap_or_default();
-    if info["fingerprint"].as_str() != Some(fingerprint.to_string().as_str()) {
-        return Err(FretdynError::new_err(format!(
+    fretdyn::apps::life::resume_checkpoint(dir, fingerprint).map_err(|why| match why {
+        Unresumable::Changed => FretdynError::new_err(format!(
             "{}: the case or a file it reads changed since the life in this folder started (or no life was started there); {again}",
             dir.display()
-        )));
-    }
-    let checkpoint = dir.join(CHECKPOINT_FILE);
-    if !checkpoint.exists() {
-        return Err(FretdynError::new_err(format!(
+        )),
+        Unresumable::NoCheckpoint => FretdynError::new_err(format!(
             "{}: no checkpoint to resume: the life there is over (life.json says how it ended) or stopped before its first checkpoint; {again}",
             dir.display()
-        )));
-    }
-    let c = LifeCheckpoint::read(&checkpoint).map_err(err)?;
-    if c.fingerprint() != fingerprint {
-        return Err(FretdynError::new_err(format!(
+        )),
+        Unresumable::OtherInputs(checkpoint) => FretdynError::new_err(format!(
             "{}: written for other inputs than the case has now; {again}",
             checkpoint.display()
-        )));
+        )),
+        Unresumable::Unreadable(e) => err(e),
+    })
+}
+
+/// The files of a life beside `life.json`, as `fretdyn life` writes them: `life.csv`,
+/// `scars.csv` and, with `refined` lives (`max_depth_change` halved: `(fraction, results)`),
+/// `convergence.csv` (the life itself first, at `max_depth_change`).
+fn life_files(
+    results: &LifeResults,
+    max_depth_change: f64,
+    refined: &[(f64, LifeResults)],
+) -> Vec<(String, String)> {
+    let mut files = vec![
+        (
+            "life.csv".to_string(),
+            fretdyn::apps::life::life_csv(results),
+        ),
+        (
+            "scars.csv".to_string(),
+            fretdyn::apps::life::scars_csv(results),
+        ),
+    ];
+    if !refined.is_empty() {
+        let lives: Vec<(f64, &LifeResults)> = std::iter::once((max_depth_change, results))
+            .chain(refined.iter().map(|(f, r)| (*f, r)))
+            .collect();
+        files.push((
+            "convergence.csv".to_string(),
+            fretdyn::apps::life::convergence_csv(&results.contacts, &lives),
+        ));
     }
-    Ok(c)
+    files
+}
+
+/// The first-order standard error of one contact's tube depth after each life step, with the
+/// scars fed back and at fixed gap, from its columns of `life.csv` (an unknown error: NaN):
+/// `fretdyn::apps::life::depth_standard_errors`, as `fretdyn life` draws it in `life.png`.
+#[pyfunction]
+pub(crate) fn life_depth_se(
+    depth: Vec<f64>,
+    fixed_gap: Vec<f64>,
+    rate: Vec<f64>,
+    rate_se: Vec<f64>,
+) -> PyResult<(Vec<f64>, Vec<f64>)> {
+    let n = depth.len();
+    if fixed_gap.len() != n || rate.len() != n || rate_se.len() != n {
+        return Err(FretdynError::new_err(
+            "life_depth_se: the four columns must have one length",
+        ));
+    }
+    Ok(fretdyn::apps::life::depth_standard_errors(
+        &depth, &fixed_gap, &rate, &rate_se,
+    ))
 }
 
 /// The service life of a case with a `[life]` section (THEORY §14.5; `fretdyn life`), with
@@ -139,9 +155,11 @@ fn read_checkpoint(dir: &Path, fingerprint: u64) -> PyResult<LifeCheckpoint> {
 /// so far are written). Returns the JSON of `life.json` (`criterion_depth`, `results`), and
 /// when the life reached its end, the lives with `max_depth_change` halved 1…`halvings`
 /// times: `(max_depth_change, JSON of their results)` each (the convergence check of
-/// `--halvings`). With `output` (a folder): the life's checkpoint (after every life step and
-/// every `checkpoint_every` s inside a window), `life_run.json` and `life.json` are written
-/// there, and `resume` continues the life stopped there (one the CLI started too: the same
+/// `--halvings`), and the text of the life's tables (`life.csv`, `scars.csv`,
+/// `convergence.csv` with halvings: `(name, text)` each, the CLI's bytes). With `output` (a
+/// folder): the life's checkpoint (after every life step and every `checkpoint_every` s
+/// inside a window), `life_run.json`, `life.json`, `life.csv`, `scars.csv` (and
+/// `convergence.csv`) are written there, as `fretdyn life` writes them, and `resume` continues the life stopped there (one the CLI started too: the same
 /// fingerprint); `case_file`, the file the case was read from unchanged, is recorded for
 /// `fretdyn life --resume`.
 #[pyfunction]
@@ -154,7 +172,7 @@ pub(crate) fn life(
     resume: bool,
     checkpoint_every: f64,
     case_file: Option<PathBuf>,
-) -> PyResult<(String, Vec<(f64, String)>)> {
+) -> PyResult<LifeOutput> {
     let c = &case.inner;
     let Some(settings) = c.life.clone() else {
         return Err(FretdynError::new_err(
@@ -186,7 +204,8 @@ pub(crate) fn life(
     let resumed = match (&output, resume) {
         (Some(dir), true) => Some(read_checkpoint(dir, fingerprint)?),
         (Some(dir), false) => {
-            start_afresh(dir, fingerprint, case_file.as_deref())?;
+            fretdyn::apps::life::start_afresh(dir, fingerprint, case_file.as_deref())
+                .map_err(err)?;
             None
         }
         (None, true) => {
@@ -209,7 +228,8 @@ pub(crate) fn life(
     let results = results.map_err(err)?;
     let json = fretdyn::apps::life::life_json(&c.title, &results, settings.criterion);
     if let Some(dir) = &output {
-        fretdyn::files::write_text_atomically(&dir.join("life.json"), &json).map_err(err)?;
+        fretdyn::apps::life::write_life(dir, &c.title, &results, settings.criterion)
+            .map_err(err)?;
         if !matches!(results.end, fretdyn::apps::life::LifeEnd::Stopped { .. }) {
             // the life is over: nothing to resume
             let _ = std::fs::remove_file(dir.join(CHECKPOINT_FILE));
@@ -235,13 +255,25 @@ pub(crate) fn life(
             if let Some(e) = interrupted {
                 return Err(e);
             }
-            let r = r.map_err(err)?;
-            let text = serde_json::to_string(&r).unwrap_or_default();
-            refined.push((finer.max_depth_change, text));
+            refined.push((finer.max_depth_change, r.map_err(err)?));
         }
     }
-    Ok((json, refined))
+    let files = life_files(&results, settings.max_depth_change, &refined);
+    if let Some(dir) = &output {
+        for (name, text) in files.iter().filter(|(name, _)| name == "convergence.csv") {
+            fretdyn::files::write_text_atomically(&dir.join(name), text).map_err(err)?;
+        }
+    }
+    let refined = refined
+        .iter()
+        .map(|(f, r)| (*f, serde_json::to_string(r).unwrap_or_default()))
+        .collect();
+    Ok((json, refined, files))
 }
+
+/// What [`life`] returns to Python: the JSON of `life.json`, the refined lives
+/// `(max_depth_change, JSON of their results)` and the tables `(file name, text)`.
+type LifeOutput = (String, Vec<(f64, String)>, Vec<(String, String)>);
 
 /// The modal basis of a case (`fretdyn modes`): a dict with `frequencies_hz`,
 /// `damping_ratio` (numpy arrays, one value per mode), `points` (names), `rows` (numpy

@@ -824,6 +824,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(apps::life, m)?)?;
+    m.add_function(wrap_pyfunction!(apps::life_depth_se, m)?)?;
     m.add_function(wrap_pyfunction!(apps::modes, m)?)?;
     m.add_function(wrap_pyfunction!(study_runs, m)?)?;
     m.add_function(wrap_pyfunction!(study_header, m)?)?;

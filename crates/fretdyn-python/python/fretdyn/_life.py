@@ -110,17 +110,18 @@ def _depths(results: dict):
     out["step"] = out["step"].astype(np.int64)
     # the first-order standard error of the depth: each life step's depth increment scaled
     # by the relative standard error of the wear work rate that drove it, the steps' errors
-    # taken as independent (the windows are independent simulations)
+    # taken as independent (the windows are independent simulations); the library's, as
+    # `fretdyn life` draws it in life.png
     se = np.full(len(out), np.nan)
     for name in names:
         rows_of = np.flatnonzero(out["contact"].to_numpy() == name)
-        depth = out["tube_depth"].to_numpy()[rows_of]
-        rate = out["wear_work_rate"].to_numpy()[rows_of]
-        rate_se = out["wear_work_rate_se"].to_numpy()[rows_of]
-        increment = np.diff(depth, prepend=0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            relative = np.where(increment > 0.0, rate_se / rate, 0.0)
-        se[rows_of] = np.sqrt(np.cumsum((increment * relative) ** 2))
+
+        def column(key):
+            return out[key].to_numpy()[rows_of].tolist()
+
+        se[rows_of], _ = _native.life_depth_se(
+            column("tube_depth"), column("tube_depth_fixed_gap"), column("wear_work_rate"),
+            column("wear_work_rate_se"))
     out.insert(out.columns.get_loc("tube_depth") + 1, "tube_depth_se", se)
     return out
 
@@ -172,8 +173,11 @@ class LifeResult:
     >>> r.convergence
     """
 
-    def __init__(self, life_json: dict, refined: list, case: Any, max_depth_change: float):
+    def __init__(self, life_json: dict, refined: list, case: Any, max_depth_change: float,
+                 files: Optional[List[tuple]] = None):
         self._json = life_json
+        # the text of life.csv, scars.csv (convergence.csv), from the library: the CLI's bytes
+        self._files = list(files or [])
         self._results = life_json["results"]
         self.criterion_depth: Optional[float] = life_json.get("criterion_depth")
         self.case = case
@@ -282,9 +286,9 @@ class LifeResult:
 
     def write(self, folder: PathLike) -> None:
         """Writes ``life.csv``, ``scars.csv`` (and ``convergence.csv`` with halvings) into
-        `folder`, with the columns of ``fretdyn life``'s (numbers written to read back exactly,
-        an empty cell for a missing value).
-        `fretdyn.life` calls it with its `output`.
+        `folder`, byte for byte as ``fretdyn life`` writes them (numbers written to read back
+        exactly, an empty cell for a missing value); `fretdyn.life` writes them into its
+        `output` already.
 
         Parameters
         ----------
@@ -301,12 +305,8 @@ class LifeResult:
         """
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
-        # pandas writes a float as Python's repr, the shortest text that reads back the
-        # same number, and NaN as an empty cell: the CLI's conventions
-        self.table.to_csv(folder / "life.csv", index=False)
-        self.scars.to_csv(folder / "scars.csv", index=False)
-        if self.convergence is not None:
-            self.convergence.to_csv(folder / "convergence.csv", index=False)
+        for name, text in self._files:
+            (folder / name).write_bytes(text.encode())
 
     def to_xarray(self):
         """The life as an xarray Dataset: dimensions ``time`` (service time, years) and
@@ -435,7 +435,7 @@ def life(
         case_file = None  # not the file's case any more
     if isinstance(halvings, bool) or not isinstance(halvings, (int, np.integer)) or halvings < 0:
         raise FretdynError(f"halvings: a number of halvings ≥ 0 (at most 10), got {halvings!r}")
-    life_json, refined = _native.life(
+    life_json, refined, files = _native.life(
         case._native, int(halvings), None if output is None else os.fspath(output),
         bool(resume), float(checkpoint_every), case_file,
     )
@@ -443,10 +443,8 @@ def life(
     settings = case.to_dict().get("life", {})
     result = LifeResult(
         data, [(f, json.loads(r)) for f, r in refined], case,
-        float(settings.get("max_depth_change", np.nan)),
+        float(settings.get("max_depth_change", np.nan)), files,
     )
-    if output is not None:
-        result.write(output)
     if result.end["status"] not in ("completed", "perforated"):
         target = settings.get("target_years", np.nan) * YEAR
         e = FretdynError(_end_message(result.end, data["results"]["steps"], target,

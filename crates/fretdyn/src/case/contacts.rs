@@ -4,7 +4,9 @@
 use nalgebra::{Vector2, Vector3};
 use serde::Deserialize;
 
-use super::{CaseFile, TubeModel, point_index, v3};
+use super::obstacle::ObstacleInput;
+use super::shared::{TubeModel, point_index, v3};
+use super::wear::WearInput;
 use crate::contact::friction::Coulomb;
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
@@ -24,7 +26,7 @@ pub(super) struct ContactSection {
     normal: NormalInput,
     friction: FrictionInput,
     /// Wear laws and scar geometry (docs/WEAR.md).
-    wear: Option<super::wear::WearInput>,
+    wear: Option<WearInput>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -69,40 +71,6 @@ impl MotionInput {
 }
 
 #[derive(Debug, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
-pub(super) enum ObstacleInput {
-    Plane {
-        #[serde(default)]
-        origin: [f64; 3],
-        normal: [f64; 3],
-        #[serde(default)]
-        gap: f64,
-        tangent: Option<[f64; 3]>,
-    },
-    Circle {
-        centre: [f64; 3],
-        axis: [f64; 3],
-        clearance: f64,
-    },
-    BiPlane {
-        #[serde(default)]
-        origin: [f64; 3],
-        normal: [f64; 3],
-        gap: f64,
-        tangent: Option<[f64; 3]>,
-    },
-    Polygon {
-        centre: [f64; 3],
-        axis: [f64; 3],
-        reference: Option<[f64; 3]>,
-        /// In-plane vertices `[x1, x2]` along (reference, axis × reference), m.
-        vertices: Option<Vec<[f64; 2]>>,
-        /// Vertices as `[angle_deg, radius]` pairs.
-        polar: Option<Vec<[f64; 2]>>,
-    },
-}
-
-#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct NormalInput {
     stiffness: f64,
@@ -118,148 +86,150 @@ pub(super) struct FrictionInput {
     mu_dynamic: Option<f64>,
 }
 
-impl CaseFile {
-    /// `[[contacts]]`: each contact's point, obstacle (and its motion), normal law and
-    /// friction coefficients (THEORY §3, §4, §7, §8).
-    pub(super) fn build_contacts(&self, tube: Option<&TubeModel>, model: &mut Model) -> Result<()> {
-        // the index of each name given so far (a search per contact was O(m²): minutes for
-        // 100 000 contacts)
-        let mut names = std::collections::HashMap::with_capacity(self.contacts.len());
-        for (k, c) in self.contacts.iter().enumerate() {
-            let field = format!("contacts[{k}]");
-            let pt = point_index(&c.point, format!("{field}.point"), model)?;
-            let obstacle = match c.obstacle {
-                ObstacleInput::Plane {
-                    origin,
-                    normal,
-                    gap,
-                    tangent,
-                } => Obstacle::Plane(Plane::new(
-                    v3(origin),
-                    v3(normal),
-                    gap,
-                    tangent.map(v3),
-                    &format!("{field}.obstacle"),
-                )?),
-                ObstacleInput::Circle {
-                    centre,
-                    axis,
-                    clearance,
-                } => Obstacle::Circle(Circle::new(
+/// `[[contacts]]`: each contact's point, obstacle (and its motion), normal law and friction
+/// coefficients (THEORY §3, §4, §7, §8).
+pub(super) fn build_contacts(
+    contacts: &[ContactSection],
+    tube: Option<&TubeModel>,
+    model: &mut Model,
+) -> Result<()> {
+    // the index of each name given so far (a search per contact was O(m²): minutes for
+    // 100 000 contacts)
+    let mut names = std::collections::HashMap::with_capacity(contacts.len());
+    for (k, c) in contacts.iter().enumerate() {
+        let field = format!("contacts[{k}]");
+        let pt = point_index(&c.point, format!("{field}.point"), model)?;
+        let obstacle = match c.obstacle {
+            ObstacleInput::Plane {
+                origin,
+                normal,
+                gap,
+                tangent,
+            } => Obstacle::Plane(Plane::new(
+                v3(origin),
+                v3(normal),
+                gap,
+                tangent.map(v3),
+                &format!("{field}.obstacle"),
+            )?),
+            ObstacleInput::Circle {
+                centre,
+                axis,
+                clearance,
+            } => Obstacle::Circle(Circle::new(
+                v3(centre),
+                v3(axis),
+                clearance,
+                &format!("{field}.obstacle"),
+            )?),
+            ObstacleInput::BiPlane {
+                origin,
+                normal,
+                gap,
+                tangent,
+            } => Obstacle::BiPlane(BiPlane::new(
+                v3(origin),
+                v3(normal),
+                gap,
+                tangent.map(v3),
+                &format!("{field}.obstacle"),
+            )?),
+            ObstacleInput::Polygon {
+                centre,
+                axis,
+                reference,
+                ref vertices,
+                ref polar,
+            } => {
+                let vertices = match (vertices, polar) {
+                    (Some(v), None) => v.iter().map(|p| Vector2::new(p[0], p[1])).collect(),
+                    (None, Some(p)) => Polygon::polar(
+                        &p.iter()
+                            .map(|p| (p[0].to_radians(), p[1]))
+                            .collect::<Vec<_>>(),
+                    ),
+                    _ => {
+                        return Err(Error::invalid(
+                            format!("{field}.obstacle"),
+                            "a polygonal hole needs either vertices ([x1, x2] pairs, m) or polar ([angle_deg, radius] pairs), not both",
+                        ));
+                    }
+                };
+                Obstacle::Polygon(Polygon::new(
                     v3(centre),
                     v3(axis),
-                    clearance,
+                    reference.map(v3),
+                    vertices,
                     &format!("{field}.obstacle"),
-                )?),
-                ObstacleInput::BiPlane {
-                    origin,
-                    normal,
-                    gap,
-                    tangent,
-                } => Obstacle::BiPlane(BiPlane::new(
-                    v3(origin),
-                    v3(normal),
-                    gap,
-                    tangent.map(v3),
-                    &format!("{field}.obstacle"),
-                )?),
-                ObstacleInput::Polygon {
-                    centre,
-                    axis,
-                    reference,
-                    ref vertices,
-                    ref polar,
-                } => {
-                    let vertices = match (vertices, polar) {
-                        (Some(v), None) => v.iter().map(|p| Vector2::new(p[0], p[1])).collect(),
-                        (None, Some(p)) => Polygon::polar(
-                            &p.iter()
-                                .map(|p| (p[0].to_radians(), p[1]))
-                                .collect::<Vec<_>>(),
-                        ),
-                        _ => {
-                            return Err(Error::invalid(
-                                format!("{field}.obstacle"),
-                                "a polygonal hole needs either vertices ([x1, x2] pairs, m) or polar ([angle_deg, radius] pairs), not both",
-                            ));
-                        }
-                    };
-                    Obstacle::Polygon(Polygon::new(
-                        v3(centre),
-                        v3(axis),
-                        reference.map(v3),
-                        vertices,
-                        &format!("{field}.obstacle"),
-                    )?)
-                }
-            };
-            let normal = NormalLaw::new(
-                c.normal.stiffness,
-                c.normal.damping,
-                &format!("{field}.normal"),
-            )?;
-            let ff = format!("{field}.friction");
-            let (mu_s, mu_d) = match (c.friction.mu, c.friction.mu_static, c.friction.mu_dynamic) {
-                (Some(mu), None, None) => (mu, mu),
-                (None, Some(s), Some(d)) => (s, d),
-                (None, Some(s), None) => (s, s),
-                (None, None, Some(d)) => (d, d),
-                _ => {
-                    return Err(Error::invalid(
-                        ff,
-                        "give either mu, or mu_static and mu_dynamic",
-                    ));
-                }
-            };
-            // errors name the key written: `mu` stands for both coefficients, and a lone
-            // `mu_static` (or `mu_dynamic`) for the other one too
-            let written = match (c.friction.mu, c.friction.mu_static, c.friction.mu_dynamic) {
-                (Some(_), _, _) => Some("mu"),
-                (None, Some(_), None) => Some("mu_static"),
-                (None, None, Some(_)) => Some("mu_dynamic"),
-                _ => None,
-            };
-            let friction = Coulomb::new(mu_s, mu_d, &ff).map_err(|e| match (e, written) {
-                (Error::Invalid { message, .. }, Some(key)) => {
-                    Error::invalid(format!("{ff}.{key}"), message)
-                }
-                (e, _) => e,
-            })?;
-            let name = c.name.clone().unwrap_or_else(|| format!("contact{k}"));
-            if let Some(j) = names.insert(name.clone(), k) {
+                )?)
+            }
+        };
+        let normal = NormalLaw::new(
+            c.normal.stiffness,
+            c.normal.damping,
+            &format!("{field}.normal"),
+        )?;
+        let ff = format!("{field}.friction");
+        let (mu_s, mu_d) = match (c.friction.mu, c.friction.mu_static, c.friction.mu_dynamic) {
+            (Some(mu), None, None) => (mu, mu),
+            (None, Some(s), Some(d)) => (s, d),
+            (None, Some(s), None) => (s, s),
+            (None, None, Some(d)) => (d, d),
+            _ => {
                 return Err(Error::invalid(
-                    format!("{field}.name"),
+                    ff,
+                    "give either mu, or mu_static and mu_dynamic",
+                ));
+            }
+        };
+        // errors name the key written: `mu` stands for both coefficients, and a lone
+        // `mu_static` (or `mu_dynamic`) for the other one too
+        let written = match (c.friction.mu, c.friction.mu_static, c.friction.mu_dynamic) {
+            (Some(_), _, _) => Some("mu"),
+            (None, Some(_), None) => Some("mu_static"),
+            (None, None, Some(_)) => Some("mu_dynamic"),
+            _ => None,
+        };
+        let friction = Coulomb::new(mu_s, mu_d, &ff).map_err(|e| match (e, written) {
+            (Error::Invalid { message, .. }, Some(key)) => {
+                Error::invalid(format!("{ff}.{key}"), message)
+            }
+            (e, _) => e,
+        })?;
+        let name = c.name.clone().unwrap_or_else(|| format!("contact{k}"));
+        if let Some(j) = names.insert(name.clone(), k) {
+            return Err(Error::invalid(
+                format!("{field}.name"),
+                format!(
+                    "'{name}' is already the name of contacts[{j}]: contact names must be unique (they label the outputs)"
+                ),
+            ));
+        }
+        if let (Some(t), true) = (tube, c.radius > 0.0) {
+            let outer = 0.5 * t.structure.beam.tube.section.outer_diameter;
+            if c.radius > outer * (1.0 + 1e-9) {
+                return Err(Error::invalid(
+                    format!("{field}.radius"),
                     format!(
-                        "'{name}' is already the name of contacts[{j}]: contact names must be unique (they label the outputs)"
+                        "{} m is larger than the tube's outer radius {} m (structure.outer_diameter/2): give the outer radius in m",
+                        number(c.radius),
+                        number(outer)
                     ),
                 ));
             }
-            if let (Some(t), true) = (tube, c.radius > 0.0) {
-                let outer = 0.5 * t.structure.beam.tube.section.outer_diameter;
-                if c.radius > outer * (1.0 + 1e-9) {
-                    return Err(Error::invalid(
-                        format!("{field}.radius"),
-                        format!(
-                            "{} m is larger than the tube's outer radius {} m (structure.outer_diameter/2): give the outer radius in m",
-                            number(c.radius),
-                            number(outer)
-                        ),
-                    ));
-                }
-            }
-            let mut contact = Contact::new(name, pt, obstacle, normal, friction);
-            contact.radius = c.radius;
-            if let Some(m) = &c.motion {
-                contact.motion = m.motion();
-            }
-            contact.validate(&model.basis.points[pt], &field)?;
-            let wear = c
-                .wear
-                .as_ref()
-                .map(|w| w.build(c.radius, &c.obstacle, &field));
-            model.wear.push(wear.transpose()?);
-            model.contacts.push(contact);
         }
-        Ok(())
+        let mut contact = Contact::new(name, pt, obstacle, normal, friction);
+        contact.radius = c.radius;
+        if let Some(m) = &c.motion {
+            contact.motion = m.motion();
+        }
+        contact.validate(&model.basis.points[pt], &field)?;
+        let wear = c
+            .wear
+            .as_ref()
+            .map(|w| w.build(c.radius, &c.obstacle, &field));
+        model.wear.push(wear.transpose()?);
+        model.contacts.push(contact);
     }
+    Ok(())
 }

@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 use serde::Deserialize;
 
-use super::{TubeModel, point_index};
+use super::shared::{Abscissae, TubeModel, point_index};
 use crate::error::{Error, Result, number};
 use crate::loads::flow::ZoneFluidElastic;
 use crate::loads::flow::{
@@ -194,16 +194,6 @@ impl FluidElasticInput {
             }
         }
     }
-}
-
-/// Where the points of a structure are along the tube, for zones given by points on a
-/// structure that is not a tube (the same order as the basis's points).
-#[derive(Debug, Clone, Default)]
-pub(super) struct Abscissae {
-    /// `s` of each point of the basis, m, if known.
-    pub s: Vec<Option<f64>>,
-    /// Where the case gives them (for the messages), e.g. "the arrays 's_<name>' of b.npz".
-    pub source: String,
 }
 
 /// The geometry the zones are placed on.

@@ -2,7 +2,7 @@
 
 use serde::Deserialize;
 
-use super::TubeModel;
+use super::shared::TubeModel;
 use crate::error::{Error, Result};
 use crate::settings::life::{DEFAULT_MAX_DEPTH_CHANGE, LifeSettings, YEAR};
 

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::Deserialize;
 
-use super::{CaseFile, TubeModel, point_index, v3};
+use super::shared::{TubeModel, named_file, point_index, v3};
 use crate::error::{Error, Result, number};
 use crate::loads::flow::{Flow, FlowZone};
 use crate::loads::spatial_correlation::{covariance_factor, line_covariance};
@@ -217,7 +217,7 @@ impl HistoryInput {
                     (Some(t), None) => t.clone(),
                     (None, Some(f)) => {
                         let key = format!("{field}.history.file");
-                        read_table(&super::named_file(base, f, &key, "the case file")?, &key)?
+                        read_table(&named_file(base, f, &key, "the case file")?, &key)?
                     }
                     _ => {
                         return Err(Error::invalid(
@@ -360,10 +360,20 @@ fn check_band_limit(f_max: f64, dt: f64, field: &str) -> Result<()> {
     Ok(())
 }
 
-impl CaseFile {
+/// The load sections of a case file, and its time step (the band limit of turbulence).
+pub(super) struct LoadSections<'a> {
+    pub loads: &'a [LoadSection],
+    pub modal_loads: &'a [ModalLoadSection],
+    pub line_loads: &'a [LineLoadSection],
+    pub turbulence: &'a [TurbulenceSection],
+    pub base_excitation: Option<&'a BaseSection>,
+    pub dt: f64,
+}
+
+impl LoadSections<'_> {
     /// `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]`, `[[turbulence]]` and
     /// `[base_excitation]`, projected on the modes (THEORY §8, §10).
-    pub(super) fn build_loads(
+    pub(super) fn build(
         &self,
         base: &Path,
         tube: Option<&TubeModel>,
@@ -515,10 +525,10 @@ impl CaseFile {
                 f_max: l.f_max,
             };
             load.validate(modes, &field)?;
-            check_band_limit(l.f_max, self.time.dt, &field)?;
+            check_band_limit(l.f_max, self.dt, &field)?;
             model.turbulence.push(load);
         }
-        if let Some(b) = &self.base_excitation {
+        if let Some(b) = self.base_excitation {
             model.base_acceleration = Some(BaseAcceleration::new(
                 v3(b.acceleration),
                 b.history.history(base, "base_excitation")?,

@@ -6,16 +6,19 @@
 //! The schema is split by section, each file holding its sections' types and the build of
 //! the model from them:
 //! - `structure`: `[structure]` and `[initial]`;
-//! - `contacts`: `[[contacts]]` (their `wear` tables in `wear`);
+//! - `contacts`: `[[contacts]]` (their `obstacle` tables in `obstacle`, their `wear` tables
+//!   in `wear`);
 //! - `loads`: `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]`, `[[turbulence]]`,
 //!   `[base_excitation]`;
 //! - `flow`: `[flow]` and its `[[flow.zones]]`;
 //! - `settings`: `[time]`, `[tangential]`, `[output]`, `[statistics]`;
 //! - `life`: `[life]`, the service life of `fretdyn life`.
 //!
-//! This module reads the file, holds the top-level schema (`CaseFile`) and builds the
-//! sections in order; [`key_path`] addresses its keys (`contacts[0].friction.mu`) for studies
-//! and the Python package.
+//! What the sections share as they are built (a tube's model, the points' abscissae, how a
+//! point or a file is named) is in `shared`, below them. This module reads the file, holds
+//! the top-level schema (`CaseFile`) and builds the sections in order, each from its own
+//! tables (the sections never import this module: no file cycle); [`key_path`] addresses
+//! its keys (`contacts[0].friction.mu`) for studies and the Python package.
 
 mod contacts;
 pub mod fingerprint;
@@ -25,23 +28,29 @@ mod life;
 mod loads;
 pub mod memory;
 mod messages;
+mod obstacle;
 mod quantities;
 mod settings;
+mod shared;
 mod structure;
 mod wear;
 
-pub use structure::TubeModel;
+pub use shared::TubeModel;
+pub(crate) use shared::named_file;
 
-use contacts::ContactSection;
+use contacts::{ContactSection, build_contacts};
 use flow::FlowSection;
 use life::LifeSection;
-use loads::{BaseSection, LineLoadSection, LoadSection, ModalLoadSection, TurbulenceSection};
-use settings::{OutputSection, StatisticsSection, TangentialSection, TimeSection};
+use loads::{
+    BaseSection, LineLoadSection, LoadSection, LoadSections, ModalLoadSection, TurbulenceSection,
+};
+use settings::{
+    OutputSection, SettingsSections, StatisticsSection, TangentialSection, TimeSection,
+};
 use structure::{InitialSection, StructureSection};
 
 use std::path::Path;
 
-use nalgebra::Vector3;
 use serde::Deserialize;
 
 use crate::error::{Error, Result};
@@ -184,25 +193,6 @@ pub fn absolute_file_names(case: &mut serde_json::Value, base: &Path) {
     histories(case, base);
 }
 
-/// The file a key names, `name` relative to `base`; an empty name is refused naming the key
-/// `field` (it was read as the folder `base` itself, or as no file at all, with an error that
-/// named neither the key nor a file: `: No such file or directory`). `relative_to` says what
-/// the name is relative to (`the case file`, `the study file`).
-pub(crate) fn named_file(
-    base: &Path,
-    name: &str,
-    field: &str,
-    relative_to: &str,
-) -> Result<std::path::PathBuf> {
-    if name.trim().is_empty() {
-        return Err(Error::invalid(
-            field,
-            format!("an empty file name: give the name of the file, relative to {relative_to}"),
-        ));
-    }
-    Ok(base.join(name))
-}
-
 /// Checks that `text` reads as a case file (TOML syntax, known keys, types), without building
 /// the case; errors give their line and column.
 pub(crate) fn check_case_text(text: &str) -> Result<()> {
@@ -274,10 +264,6 @@ struct CaseFile {
     life: Option<LifeSection>,
 }
 
-fn v3(a: [f64; 3]) -> Vector3<f64> {
-    Vector3::new(a[0], a[1], a[2])
-}
-
 /// What a case file builds: the model, the settings, a tube's finite-element model, the flow,
 /// the abscissae of the basis's points.
 type Built = (
@@ -295,12 +281,20 @@ impl CaseFile {
         let (basis, tube, abscissae) = self.structure.build(base, warnings)?;
         basis.validate("structure")?;
         let mut model = Model::new(basis);
-        self.build_contacts(tube.as_deref(), &mut model)?;
+        build_contacts(&self.contacts, tube.as_deref(), &mut model)?;
         let flow = match &self.flow {
             Some(f) => Some(Box::new(f.build(tube.as_deref(), &abscissae, &model)?)),
             None => None,
         };
-        self.build_loads(base, tube.as_deref(), flow.as_deref(), &mut model)?;
+        let loads = LoadSections {
+            loads: &self.loads,
+            modal_loads: &self.modal_loads,
+            line_loads: &self.line_loads,
+            turbulence: &self.turbulence,
+            base_excitation: self.base_excitation.as_ref(),
+            dt: self.time.dt,
+        };
+        loads.build(base, tube.as_deref(), flow.as_deref(), &mut model)?;
         if let Some(f) = &flow {
             let hz: Vec<f64> = model
                 .basis
@@ -310,22 +304,19 @@ impl CaseFile {
                 .collect();
             model.fluid_elastic = f.fluid_elastic(&hz);
         }
-        self.build_initial(&mut model)?;
+        if let Some(initial) = &self.initial {
+            initial.build(&mut model)?;
+        }
         model.validate()?;
-        let settings = self.settings(&model)?;
+        let sections = SettingsSections {
+            time: &self.time,
+            tangential: &self.tangential,
+            output: &self.output,
+            statistics: &self.statistics,
+        };
+        let settings = sections.settings(&model)?;
         let mut point_abscissae = abscissae.s;
         point_abscissae.resize(model.basis.points.len(), None);
         Ok((model, settings, tube, flow, point_abscissae))
     }
-}
-
-/// The index of the structure point `name`; `field` is where the case names it.
-fn point_index(name: &str, field: String, model: &Model) -> Result<usize> {
-    model.basis.point_index(name).ok_or_else(|| {
-        let known: Vec<&str> = model.basis.points.iter().map(|p| p.name.as_str()).collect();
-        Error::invalid(
-            field,
-            format!("unknown point '{name}': the structure has {known:?}"),
-        )
-    })
 }

@@ -3,7 +3,6 @@
 
 use serde::Deserialize;
 
-use super::CaseFile;
 use crate::accumulate::statistics::StatisticsSettings;
 use crate::contact::friction::LocalSolve;
 use crate::contact::tangential::{
@@ -198,11 +197,19 @@ impl GaussSeidelInput {
     }
 }
 
-impl CaseFile {
+/// The sections of a case file that set the numerical settings of a run.
+pub(super) struct SettingsSections<'a> {
+    pub time: &'a TimeSection,
+    pub tangential: &'a TangentialSection,
+    pub output: &'a OutputSection,
+    pub statistics: &'a StatisticsSection,
+}
+
+impl SettingsSections<'_> {
     /// `[time]`, `[tangential]`, `[output]` and `[statistics]`: the run settings, checked
     /// against the model's stable time step (THEORY §2, §4, §5).
     pub(super) fn settings(&self, model: &Model) -> Result<RunSettings> {
-        let t = &self.tangential;
+        let t = self.tangential;
         let method = match t.method {
             MethodName::Penalty => {
                 let p = t.penalty.as_ref().ok_or_else(|| {
@@ -249,7 +256,7 @@ impl CaseFile {
                 ),
             ));
         }
-        let statistics = &self.statistics;
+        let statistics = self.statistics;
         // a step counts in the window when its middle is after t_start (THEORY §5): the last
         // step's middle is half a step before the end
         let last_middle = ((duration / dt).round() - 0.5) * dt;

@@ -7,8 +7,7 @@ use std::path::Path;
 use nalgebra::Vector3;
 use serde::Deserialize;
 
-use super::flow::Abscissae;
-use super::{CaseFile, point_index, v3};
+use super::shared::{Abscissae, TubeModel, named_file, point_index, v3};
 use crate::error::{Error, Result, number};
 use crate::model::Model;
 use crate::structure::beam::{
@@ -16,7 +15,7 @@ use crate::structure::beam::{
 };
 use crate::structure::eigen::ModeSelection;
 use crate::structure::modal::{ModalBasis, PinnedBeam, Point, check_damping_ratio};
-use crate::structure::tube::{Damping, NamedPoint, TubeBasis, TubeStructure, node_at};
+use crate::structure::tube::{Damping, NamedPoint, TubeStructure, node_at};
 
 #[derive(Debug, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
@@ -367,15 +366,6 @@ fn spring_restraints(k: &[f64; 6], field: &str) -> Result<[Restraint; 6]> {
     }))
 }
 
-/// A tube case keeps its finite-element model and full modes (for `fretdyn modes`).
-#[derive(Debug, Clone)]
-pub struct TubeModel {
-    /// The structure as described in the case.
-    pub structure: TubeStructure,
-    /// Its modes.
-    pub basis: TubeBasis,
-}
-
 impl StructureSection {
     pub(super) fn build(
         &self,
@@ -463,7 +453,7 @@ impl StructureSection {
             } => {
                 let mut basis = match (file, frequencies_hz) {
                     (Some(f), None) => {
-                        let path = super::named_file(base, f, "structure.file", "the case file")?;
+                        let path = named_file(base, f, "structure.file", "the case file")?;
                         let file = crate::structure::basis_file::read_basis_npz(&path)?;
                         warnings.extend(file.warnings);
                         abscissae.s = file.abscissae;
@@ -549,44 +539,42 @@ impl StructureSection {
     }
 }
 
-impl CaseFile {
+impl InitialSection {
     /// `[initial]`: the initial state, at a point or in modal coordinates.
-    pub(super) fn build_initial(&self, model: &mut Model) -> Result<()> {
-        if let Some(init) = &self.initial {
-            let p = model.basis.modes();
-            match (&init.point, &init.q, &init.qdot) {
-                (Some(name), None, None) => {
-                    let pt = point_index(name, "initial.point".into(), model)?;
-                    for (key, v, unit) in [
-                        ("displacement", init.displacement, "m"),
-                        ("velocity", init.velocity, "m/s"),
-                    ] {
-                        if let Some(v) = v.filter(|v| v.iter().any(|x| !x.is_finite())) {
-                            return Err(Error::invalid(
-                                format!("initial.{key}"),
-                                format!(
-                                    "must be 3 finite numbers [x, y, z] in {unit} (got [{}, {}, {}])",
-                                    v[0], v[1], v[2]
-                                ),
-                            ));
-                        }
+    pub(super) fn build(&self, model: &mut Model) -> Result<()> {
+        let p = model.basis.modes();
+        match (&self.point, &self.q, &self.qdot) {
+            (Some(name), None, None) => {
+                let pt = point_index(name, "initial.point".into(), model)?;
+                for (key, v, unit) in [
+                    ("displacement", self.displacement, "m"),
+                    ("velocity", self.velocity, "m/s"),
+                ] {
+                    if let Some(v) = v.filter(|v| v.iter().any(|x| !x.is_finite())) {
+                        return Err(Error::invalid(
+                            format!("initial.{key}"),
+                            format!(
+                                "must be 3 finite numbers [x, y, z] in {unit} (got [{}, {}, {}])",
+                                v[0], v[1], v[2]
+                            ),
+                        ));
                     }
-                    model.set_initial_from_point(
-                        pt,
-                        v3(init.displacement.unwrap_or_default()),
-                        v3(init.velocity.unwrap_or_default()),
-                    )?;
                 }
-                (None, q, qd) if init.displacement.is_none() && init.velocity.is_none() => {
-                    model.initial.q = q.clone().unwrap_or_else(|| vec![0.0; p]);
-                    model.initial.qdot = qd.clone().unwrap_or_else(|| vec![0.0; p]);
-                }
-                _ => {
-                    return Err(Error::invalid(
-                        "initial",
-                        "give either point with displacement/velocity, or q/qdot (modal), not both",
-                    ));
-                }
+                model.set_initial_from_point(
+                    pt,
+                    v3(self.displacement.unwrap_or_default()),
+                    v3(self.velocity.unwrap_or_default()),
+                )?;
+            }
+            (None, q, qd) if self.displacement.is_none() && self.velocity.is_none() => {
+                model.initial.q = q.clone().unwrap_or_else(|| vec![0.0; p]);
+                model.initial.qdot = qd.clone().unwrap_or_else(|| vec![0.0; p]);
+            }
+            _ => {
+                return Err(Error::invalid(
+                    "initial",
+                    "give either point with displacement/velocity, or q/qdot (modal), not both",
+                ));
             }
         }
         Ok(())

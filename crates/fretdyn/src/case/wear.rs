@@ -3,7 +3,7 @@
 
 use serde::Deserialize;
 
-use super::contacts::ObstacleInput;
+use super::obstacle::ObstacleInput;
 use crate::error::{Error, Result, number};
 use crate::wear::{ContactWear, HoleScar, Scar, WearLaw, WearWork};
 
