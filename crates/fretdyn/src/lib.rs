@@ -67,7 +67,7 @@ pub mod apps;
 
 pub mod error;
 pub mod files;
-mod kernels;
+pub(crate) mod numerics;
 
 // The README's Rust example is compiled with the doctests.
 #[cfg(doctest)]

@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use crate::error::number;
-use crate::kernels::running_max;
+use crate::numerics::running_max;
 
 /// Relative error of the energy balance ([`EnergyBalance::relative_error`]) above which a run
 /// is worth a warning: 1 %, about what 15 steps per impact give (VERIFICATION.md "Steps per

@@ -300,16 +300,16 @@ const PEAK_MIN_DECADE: i32 = -6;
 const PEAK_DECADES: usize = 15;
 
 /// `min(m, x)` for a running minimum `m` that is never NaN (a NaN `x` is skipped):
-/// [`crate::kernels::running_min`].
+/// [`crate::numerics::running_min`].
 #[inline(always)]
 fn smaller(m: f64, x: f64) -> f64 {
-    crate::kernels::running_min(m, x)
+    crate::numerics::running_min(m, x)
 }
 
 /// `max(m, x)` for a running maximum `m` that is never NaN, as [`smaller`].
 #[inline(always)]
 fn larger(m: f64, x: f64) -> f64 {
-    crate::kernels::running_max(m, x)
+    crate::numerics::running_max(m, x)
 }
 
 /// Running sums of one contact over a window or a block. The number of steps is the same for

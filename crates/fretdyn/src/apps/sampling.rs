@@ -1,73 +1,12 @@
 //! Random draws of study parameters (`docs/STUDIES.md`): the distributions a study file may give
-//! instead of a list of values, and the counter-based generator that makes every draw a pure
-//! function of `(study seed, sample, parameter, element)`: the same study gives the same draws
-//! whatever runs them, in whatever order (rayon here, Dask workers in Python).
-//!
-//! The generator is SplitMix64 (Steele, Lea & Flood 2014): the `j`-th output of the stream
-//! with key `k` is `mix64(k + (j+1)·γ)`, `γ = 0x9e3779b97f4a7c15`, and the key of a stream is
-//! the seed folded with its indices through `mix64` (Stafford's variant 13 finaliser, a
-//! bijection with full avalanche), so that streams of neighbouring indices are unrelated.
+//! instead of a list of values, drawn from a [`Stream`] of the crate's one counter-based
+//! generator ([`crate::numerics::rng`]: SplitMix64), so that every draw is a pure function of
+//! `(study seed, sample, parameter, element)`: the same study gives the same draws whatever
+//! runs them, in whatever order (rayon here, Dask workers in Python).
 
 use crate::error::{Error, Result};
 
-const GOLDEN_GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
-
-/// SplitMix64 output function (Stafford's variant 13): a bijection of `u64`.
-#[inline]
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// A reproducible stream of random numbers identified by a seed and a list of indices.
-#[derive(Debug, Clone)]
-pub struct Stream {
-    key: u64,
-    counter: u64,
-}
-
-impl Stream {
-    /// The stream of `seed` and `indices` (e.g. `[sample, parameter, element]`): its numbers
-    /// depend on nothing else.
-    pub fn new(seed: u64, indices: &[u64]) -> Self {
-        let key = indices.iter().fold(mix64(seed ^ GOLDEN_GAMMA), |k, &i| {
-            mix64(k ^ mix64(i.wrapping_add(GOLDEN_GAMMA)))
-        });
-        Self { key, counter: 0 }
-    }
-
-    /// Next 64 random bits (SplitMix64).
-    #[inline]
-    pub fn next_u64(&mut self) -> u64 {
-        self.counter = self.counter.wrapping_add(1);
-        mix64(
-            self.key
-                .wrapping_add(self.counter.wrapping_mul(GOLDEN_GAMMA)),
-        )
-    }
-
-    /// Uniform on `[0, 1)`, 53 bits.
-    #[inline]
-    pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    /// Uniform integer in `0..n` (`n > 0`), by Lemire's multiply-shift (bias below `n/2⁶⁴`).
-    #[inline]
-    pub fn below(&mut self, n: usize) -> usize {
-        ((self.next_u64() as u128 * n as u128) >> 64) as usize
-    }
-
-    /// Standard normal by Box–Muller, `√(−2 ln u₁) cos 2πu₂` with `u₁ ∈ (0, 1]`,
-    /// `u₂ ∈ [0, 1)` (one normal per two uniforms: the sine is not kept, so that a draw
-    /// uses a fixed number of the stream's numbers).
-    pub fn normal(&mut self) -> f64 {
-        let u1 = 1.0 - self.uniform();
-        let u2 = self.uniform();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
-}
+pub use crate::numerics::rng::Stream;
 
 /// A distribution of a study parameter.
 #[derive(Debug, Clone, PartialEq)]
@@ -466,29 +405,5 @@ mod tests {
         assert!((normal_cdf(-1.0) - 0.158_655_254).abs() < 1e-7);
         assert_eq!(normal_cdf(f64::INFINITY), 1.0);
         assert_eq!(normal_cdf(f64::NEG_INFINITY), 0.0);
-    }
-
-    #[test]
-    fn streams_of_other_indices_differ_and_one_repeats() {
-        let a: Vec<u64> = (0..4)
-            .map({
-                let mut s = Stream::new(7, &[0, 1]);
-                move |_| s.next_u64()
-            })
-            .collect();
-        let b: Vec<u64> = (0..4)
-            .map({
-                let mut s = Stream::new(7, &[0, 1]);
-                move |_| s.next_u64()
-            })
-            .collect();
-        let c: Vec<u64> = (0..4)
-            .map({
-                let mut s = Stream::new(7, &[1, 0]);
-                move |_| s.next_u64()
-            })
-            .collect();
-        assert_eq!(a, b);
-        assert_ne!(a, c);
     }
 }

@@ -19,7 +19,7 @@ use nalgebra::{Vector2, Vector3};
 use crate::contact::Contact;
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::ContactFrame;
-use crate::kernels::Lanes;
+use crate::numerics::Lanes;
 use crate::structure::modal::Point;
 
 /// The frame rows of one contact (see the module's documentation).

@@ -30,7 +30,7 @@ use nalgebra::Vector3;
 
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::{ContactFrame, Obstacle};
-use crate::kernels::map3;
+use crate::numerics::map3;
 use crate::structure::modal::{Point, thirds};
 
 /// Normal penalty law `R_N = max(0, K_N δ + C_N δ̇)` for `δ > 0`, `R_N = 0` otherwise (THEORY §3).

@@ -19,8 +19,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::kernels::{Lanes, Portable};
 use crate::model::{Coordinates, Model};
+use crate::numerics::{Lanes, Portable};
 
 /// The linear operators of the coordinates.
 #[derive(Debug, Clone)]
@@ -134,7 +134,7 @@ impl CentralDifference {
         self.predict_with::<Portable>()
     }
 
-    /// [`Self::predict`] with the kernels `K` ([`crate::kernels`]): `q += Δt q̇ + ½Δt² q̈`,
+    /// [`Self::predict`] with the kernels `K` ([`crate::numerics`]): `q += Δt q̇ + ½Δt² q̈`,
     /// `q̇* = q̇ + ½Δt q̈`.
     #[inline(always)]
     pub(crate) fn predict_with<K: Lanes>(&mut self) {
@@ -172,7 +172,7 @@ impl CentralDifference {
         self.free_acceleration_with::<Portable>(force)
     }
 
-    /// [`Self::free_acceleration`] with the kernels `K` ([`crate::kernels`]).
+    /// [`Self::free_acceleration`] with the kernels `K` ([`crate::numerics`]).
     #[inline(always)]
     pub(crate) fn free_acceleration_with<K: Lanes>(&mut self, force: &[f64]) {
         match &mut self.operators {
@@ -257,7 +257,7 @@ impl CentralDifference {
         self.correct_with::<Portable>(f)
     }
 
-    /// [`Self::correct`] with the reduction kernels `K` ([`crate::kernels`]).
+    /// [`Self::correct`] with the reduction kernels `K` ([`crate::numerics`]).
     #[inline(always)]
     pub(crate) fn correct_with<K: Lanes>(&mut self, f: &[f64]) -> (f64, f64, f64) {
         let h = 0.5 * self.dt;
@@ -290,7 +290,7 @@ impl CentralDifference {
         match &self.operators {
             Operators::Modal {
                 omega2, damping, ..
-            } => crate::kernels::energy_sums(&self.qd, &self.q, omega2, damping, f),
+            } => crate::numerics::energy_sums(&self.qd, &self.q, omega2, damping, f),
             Operators::Dense {
                 mass,
                 stiffness,

@@ -30,7 +30,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::kernels::Lanes;
+use crate::numerics::Lanes;
 
 /// A modal matrix (`p × p`, row-major) or its diagonal.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,7 +43,7 @@ pub enum ModalMatrix {
 
 impl ModalMatrix {
     /// `out += s · M x` (`p = x.len()`; `work` holds p values), the rows' products summed by
-    /// the kernels `K` ([`crate::kernels::Lanes::dots`]).
+    /// the kernels `K` ([`crate::numerics::Lanes::dots`]).
     #[inline(always)]
     fn mul_add<K: Lanes>(&self, s: f64, x: &[f64], work: &mut [f64], out: &mut [f64]) {
         match self {

@@ -319,12 +319,12 @@ pub(crate) fn thirds(rows: &[f64], p: usize) -> [&[f64]; 3] {
 /// `u = Φ_c x` for one point's 3 × p rows.
 #[inline(always)]
 pub fn recombine(rows: &[f64], x: &[f64]) -> Vector3<f64> {
-    recombine_with::<crate::kernels::Portable>(rows, x)
+    recombine_with::<crate::numerics::Portable>(rows, x)
 }
 
-/// [`recombine`] with the reduction kernels `K` ([`crate::kernels`]).
+/// [`recombine`] with the reduction kernels `K` ([`crate::numerics`]).
 #[inline(always)]
-pub(crate) fn recombine_with<K: crate::kernels::Lanes>(rows: &[f64], x: &[f64]) -> Vector3<f64> {
+pub(crate) fn recombine_with<K: crate::numerics::Lanes>(rows: &[f64], x: &[f64]) -> Vector3<f64> {
     let p = x.len();
     Vector3::new(
         K::dot(&rows[..p], x),
@@ -351,20 +351,20 @@ pub fn project_add(rows: &[f64], f: &Vector3<f64>, out: &mut [f64]) {
 /// Rounding differs from a left-to-right sum by round-off only.
 #[inline(always)]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    use crate::kernels::Lanes;
-    crate::kernels::Portable::dot(a, b)
+    use crate::numerics::Lanes;
+    crate::numerics::Portable::dot(a, b)
 }
 
 /// The two dot products `(a·b, a·c)` in one pass over `a` ([`dot`]'s summation).
 #[inline(always)]
 pub fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
-    use crate::kernels::Lanes;
-    crate::kernels::Portable::dot2(a, b, c)
+    use crate::numerics::Lanes;
+    crate::numerics::Portable::dot2(a, b, c)
 }
 
-/// `out += s x` on equal-length slices (the step's kernel, `crate::kernels`).
+/// `out += s x` on equal-length slices (the step's kernel, `crate::numerics`).
 #[inline(always)]
 pub fn axpy(out: &mut [f64], s: f64, x: &[f64]) {
-    use crate::kernels::Lanes;
-    crate::kernels::Portable::axpy(out, s, x)
+    use crate::numerics::Lanes;
+    crate::numerics::Portable::axpy(out, s, x)
 }

@@ -173,7 +173,7 @@ impl SolverStatistics {
     /// Counts one step's residual.
     pub fn add_residual(&mut self, r: f64) {
         // the running maximum starts at 0 and skips a NaN `r`
-        self.residual_max = crate::kernels::running_max(self.residual_max, r);
+        self.residual_max = crate::numerics::running_max(self.residual_max, r);
         self.residual_sum += r;
         if !(r <= 1e-8) {
             self.residual_steps_above_1e_8 += 1;

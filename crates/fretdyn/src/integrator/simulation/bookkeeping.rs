@@ -7,7 +7,7 @@ use crate::accumulate::recorder::{ContactSample, Recorder};
 use crate::accumulate::statistics::{ContactStep, StepValues};
 use crate::contact::frame_rows::FrameRows;
 use crate::contact::friction::Slide;
-use crate::kernels::Lanes;
+use crate::numerics::Lanes;
 use crate::structure::modal::recombine;
 
 impl Simulation<'_> {

@@ -14,7 +14,7 @@ use nalgebra::{Vector2, Vector3};
 use super::contact_kinds::{CommonContacts, ContactKinds};
 use super::{ContactState, Simulation, Tangential, contact_rows, contact_states};
 use crate::contact::frame_rows::FrameRows;
-use crate::kernels::Lanes;
+use crate::numerics::Lanes;
 use crate::structure::modal::recombine_with;
 
 impl Simulation<'_> {

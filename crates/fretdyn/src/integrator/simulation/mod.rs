@@ -48,10 +48,10 @@ use crate::contact::tangential::{SolverStatistics, TangentialMethod};
 use crate::error::{Error, Result};
 use crate::integrator::central_difference::CentralDifference;
 use crate::integrator::stability::stable_time_step;
-use crate::kernels::{Lanes, PaddedRows, Portable};
 use crate::loads::fluid_elastic::{DelayHistory, FluidElasticForce};
 use crate::loads::stepped::SteppedHistory;
 use crate::model::Model;
+use crate::numerics::{Lanes, PaddedRows, Portable};
 use crate::structure::modal::project_add;
 
 /// Everything that the steps after step `step` depend on: a run restored from it continues
@@ -760,10 +760,10 @@ impl<'m> Simulation<'m> {
         n: u64,
     ) -> std::result::Result<u64, Divergence> {
         // each version of the step its own copy of the kernels, inlined
-        self.steps_with::<crate::kernels::Avx2<O>, O>(n)
+        self.steps_with::<crate::numerics::Avx2<O>, O>(n)
     }
 
-    /// [`Self::steps`] with the reduction kernels `K` ([`crate::kernels`]), for the contacts
+    /// [`Self::steps`] with the reduction kernels `K` ([`crate::numerics`]), for the contacts
     /// `O`.
     #[inline(always)]
     fn steps_with<K: Lanes, O: ContactKinds>(

@@ -4,7 +4,7 @@
 
 use super::contact_kinds::ContactKinds;
 use super::{Simulation, Tangential, contact_rows, contact_states};
-use crate::kernels::Lanes;
+use crate::numerics::Lanes;
 use crate::structure::modal::project_add;
 
 impl Simulation<'_> {

@@ -11,8 +11,8 @@ use crate::contact::tangential::active_set::{ActiveSet, History, Outcome};
 use crate::contact::tangential::penalty::PenaltyContact;
 use crate::contact::tangential::{StickVelocity, gauss_seidel};
 use crate::integrator::central_difference::CentralDifference;
-use crate::kernels::Lanes;
 use crate::model::Model;
+use crate::numerics::Lanes;
 
 impl Simulation<'_> {
     /// Step 6 for the Lagrange methods.
