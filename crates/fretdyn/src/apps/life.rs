@@ -363,12 +363,11 @@ enum WindowEnd {
     Stopped(Box<WindowProgress>),
 }
 
-/// A window under way: its simulation's state and where its wear work was done so far, at
-/// the end of a batch of steps (a checkpoint inside a long window).
+/// A window under way: its simulation's state, where its wear work was done so far
+/// included, at the end of a batch of steps (a checkpoint inside a long window).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct WindowProgress {
     snapshot: Snapshot,
-    map: WearMap,
 }
 
 /// Runs one window of `model`, tracking where the friction work is done, from its start or
@@ -388,25 +387,18 @@ fn window(
             sim.track_wear(bins);
             sim
         }
-        Some(p) => {
-            let mut sim = Simulation::resume(model, &case.settings, p.snapshot, 1)?;
-            sim.track_wear_from(p.map);
-            sim
-        }
+        Some(p) => Simulation::resume(model, &case.settings, p.snapshot, 1)?,
     };
     let mut stopped = None;
-    let (results, map) = statistics_run_from(sim, &case.settings, &mut |sim| {
+    let (results, map) = statistics_run_from(sim, &mut |sim| {
         let here = || WindowProgress {
             snapshot: sim.snapshot(),
-            map: sim.wear_map().cloned().expect("tracked"),
         };
-        match at_batch(&here) {
-            ControlFlow::Continue(()) => ControlFlow::Continue(()),
-            ControlFlow::Break(()) => {
-                stopped = Some(here());
-                ControlFlow::Break(sim.steps_done())
-            }
+        let flow = at_batch(&here);
+        if flow.is_break() {
+            stopped = Some(here());
         }
+        flow
     })?;
     if let Some(progress) = stopped {
         return Ok(WindowEnd::Stopped(Box::new(progress)));
@@ -757,8 +749,9 @@ pub struct LifeCheckpoint {
 
 /// First bytes of a service life's checkpoint.
 pub const LIFE_CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNL";
-/// Format version of a service life's checkpoint.
-pub const LIFE_CHECKPOINT_FORMAT: u32 = 1;
+/// Format version of a service life's checkpoint (1: the window's wear map beside its
+/// simulation's hand-kept snapshot).
+pub const LIFE_CHECKPOINT_FORMAT: u32 = 2;
 
 impl LifeCheckpoint {
     /// Reads the checkpoint at `path`; the error says why it cannot be resumed.
