@@ -257,7 +257,7 @@ fn modes_prints_the_table_and_writes_basis_and_picture() {
 
 /// Step of the last checkpoint in a run folder, if there is one.
 fn checkpoint_step(dir: &Path) -> Option<u64> {
-    fretdyn::output::stream::checkpoint_step(dir).ok()
+    fretdyn::output::checkpoint::checkpoint_step(dir).ok()
 }
 
 fn npz_f64(dir: &Path, key: &str) -> ndarray::ArrayD<f64> {

@@ -8,6 +8,7 @@ use std::path::Path;
 use fretdyn::accumulate::statistics::StatisticsSettings;
 use fretdyn::case::Case;
 use fretdyn::integrator::simulation::{Progress, RunResults, Termination, simulate};
+use fretdyn::output::checkpoint;
 use fretdyn::output::stream::{self, ProgressOnly, StreamObserver, StreamSettings};
 use ndarray::{ArrayD, IxDyn};
 use ndarray_npy::NpzReader;
@@ -231,7 +232,7 @@ fn a_run_killed_before_packing_is_finished_by_resume() {
         )
     });
     assert!(died.is_err());
-    assert_eq!(stream::checkpoint_step(&killed).unwrap(), steps);
+    assert_eq!(checkpoint::checkpoint_step(&killed).unwrap(), steps);
     assert!(!killed.join("results.npz").exists());
     let r = resume(&case, &killed, 7).unwrap();
     same_statistics(&r_full, &r);
@@ -268,7 +269,7 @@ fn a_checkpoint_of_another_version_is_refused() {
     assert_eq!(&bytes[..8], b"FRETDYNC");
     assert_eq!(
         u32::from_le_bytes(bytes[8..12].try_into().unwrap()),
-        stream::CHECKPOINT_FORMAT
+        checkpoint::CHECKPOINT_FORMAT
     );
     assert_eq!(bytes[12] as usize, version.len());
     assert_eq!(&bytes[13..13 + version.len()], version.as_bytes());
@@ -291,7 +292,7 @@ fn a_checkpoint_of_another_version_is_refused() {
         assert!(err.contains("start the run again"), "{err}");
     };
     refused(
-        with_header(stream::CHECKPOINT_FORMAT, "9.9.9"),
+        with_header(checkpoint::CHECKPOINT_FORMAT, "9.9.9"),
         &[
             "written by fretdyn 9.9.9",
             &format!("this is fretdyn {version}"),
@@ -304,13 +305,15 @@ fn a_checkpoint_of_another_version_is_refused() {
     refused(with_header(4, version), &["checkpoint format 4"]);
     // format 5: the angle of an impact's peak formed at the peak
     refused(with_header(5, version), &["checkpoint format 5"]);
+    // format 6: a snapshot copied field by field from the run, not its state as it is
+    refused(with_header(6, version), &["checkpoint format 6"]);
     // format 1: bincode, starting with its version (1u32) and the fingerprint
     let mut old = 1u32.to_le_bytes().to_vec();
     old.extend_from_slice(&7u64.to_le_bytes());
     old.extend_from_slice(payload);
     refused(old, &["not a checkpoint of this fretdyn"]);
     refused(
-        with_header(stream::CHECKPOINT_FORMAT, version)[..40].to_vec(),
+        with_header(checkpoint::CHECKPOINT_FORMAT, version)[..40].to_vec(),
         &["damaged"],
     );
     // the checkpoint as written resumes

@@ -46,7 +46,7 @@ impl Drop for Scratch {
 /// later (it must still be running: a run that ends first fails the test), then `kill -9`s it.
 pub fn kill_past_checkpoint(child: &mut std::process::Child, dir: &Path, step: u64) {
     let start = std::time::Instant::now();
-    while fretdyn::output::stream::checkpoint_step(dir)
+    while fretdyn::output::checkpoint::checkpoint_step(dir)
         .ok()
         .is_none_or(|n| n < step)
     {

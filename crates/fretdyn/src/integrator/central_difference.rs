@@ -18,9 +18,10 @@
 //! solver of [`Coordinates::Physical`]: with every mode kept the two give the same motion.
 
 use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
 
-use crate::model::{Coordinates, Model};
 use crate::numerics::{Lanes, Portable};
+use crate::model::{Coordinates, Model};
 
 /// The linear operators of the coordinates.
 #[derive(Debug, Clone)]
@@ -42,25 +43,44 @@ enum Operators {
     },
 }
 
-/// State and constants of the integrator.
-#[derive(Debug, Clone)]
-pub struct CentralDifference {
-    /// Time step Δt, s.
-    pub dt: f64,
-    operators: Operators,
+/// The modal state a step carries to the next: `q_n`, `q̇_n`, `q̈_n` (part of a run's
+/// checkpointed state, [`crate::integrator::simulation::State`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModalState {
     /// Displacements `q_n`.
     pub q: Vec<f64>,
     /// Velocities `q̇_n` (full step).
     pub qd: Vec<f64>,
     /// Accelerations `q̈_n`.
     pub qdd: Vec<f64>,
+}
+
+impl ModalState {
+    /// The state `q`, `q̇` with a zero acceleration (set by [`CentralDifference::start`]).
+    pub fn new(q: &[f64], qd: &[f64]) -> Self {
+        Self {
+            q: q.to_vec(),
+            qd: qd.to_vec(),
+            qdd: vec![0.0; q.len()],
+        }
+    }
+}
+
+/// The constants of the integrator and the predicted velocity of the step under way; the
+/// state it advances ([`ModalState`]) is passed to each phase.
+#[derive(Debug, Clone)]
+pub struct CentralDifference {
+    /// Time step Δt, s.
+    pub dt: f64,
+    operators: Operators,
     /// Predicted velocity `q̇*` of the current step.
     pub qd_star: Vec<f64>,
 }
 
 impl CentralDifference {
-    /// Integrator for `model` at rest; set `q`, `qd` then call [`start`](Self::start).
-    /// The model must have been validated (a physical mass matrix is then positive definite).
+    /// Integrator for `model`; a [`ModalState`] set to the initial `q`, `q̇` then goes to
+    /// [`start`](Self::start). The model must have been validated (a physical mass matrix is
+    /// then positive definite).
     pub fn new(model: &Model, dt: f64) -> Self {
         let basis = &model.basis;
         let p = basis.modes();
@@ -98,21 +118,18 @@ impl CentralDifference {
         Self {
             dt,
             operators,
-            q: vec![0.0; p],
-            qd: vec![0.0; p],
-            qdd: vec![0.0; p],
             qd_star: vec![0.0; p],
         }
     }
 
     /// Initial acceleration `q̈_0 = M⁻¹ (f_0 − K q_0 − C q̇_0)` from the force at t = 0.
-    pub fn start(&mut self, force: &[f64]) {
+    pub fn start(&mut self, x: &mut ModalState, force: &[f64]) {
         match &mut self.operators {
             Operators::Modal {
                 omega2, damping, ..
             } => {
-                for i in 0..self.q.len() {
-                    self.qdd[i] = force[i] - omega2[i] * self.q[i] - damping[i] * self.qd[i];
+                for i in 0..x.q.len() {
+                    x.qdd[i] = force[i] - omega2[i] * x.q[i] - damping[i] * x.qd[i];
                 }
             }
             Operators::Dense {
@@ -122,42 +139,41 @@ impl CentralDifference {
                 work,
                 ..
             } => {
-                residual(force, stiffness, &self.q, damping, &self.qd, work);
-                mat_vec(m_inv, work.as_slice(), &mut self.qdd);
+                residual(force, stiffness, &x.q, damping, &x.qd, work);
+                mat_vec(m_inv, work.as_slice(), &mut x.qdd);
             }
         }
     }
 
     /// Steps 1–2: positions at `n+1` and predicted velocity.
     #[inline(always)]
-    pub fn predict(&mut self) {
-        self.predict_with::<Portable>()
+    pub fn predict(&mut self, x: &mut ModalState) {
+        self.predict_with::<Portable>(x)
     }
 
-    /// [`Self::predict`] with the kernels `K` ([`crate::numerics`]): `q += Δt q̇ + ½Δt² q̈`,
+    /// [`Self::predict`] with the kernels `K` ([`crate::kernels`]): `q += Δt q̇ + ½Δt² q̈`,
     /// `q̇* = q̇ + ½Δt q̈`.
     #[inline(always)]
-    pub(crate) fn predict_with<K: Lanes>(&mut self) {
+    pub(crate) fn predict_with<K: Lanes>(&mut self, x: &mut ModalState) {
         let dt = self.dt;
-        K::predict(
-            &mut self.q,
-            &mut self.qd_star,
-            &self.qd,
-            &self.qdd,
-            dt,
-            0.5 * dt,
-        );
+        K::predict(&mut x.q, &mut self.qd_star, &x.qd, &x.qdd, dt, 0.5 * dt);
     }
 
     /// [`Self::predict_with`] and, in the same pass, `f = s g` (the first load's modal force).
     #[inline(always)]
-    pub(crate) fn predict_and_scale_with<K: Lanes>(&mut self, f: &mut [f64], s: f64, g: &[f64]) {
+    pub(crate) fn predict_and_scale_with<K: Lanes>(
+        &mut self,
+        x: &mut ModalState,
+        f: &mut [f64],
+        s: f64,
+        g: &[f64],
+    ) {
         let dt = self.dt;
         K::predict_and_scale(
-            &mut self.q,
+            &mut x.q,
             &mut self.qd_star,
-            &self.qd,
-            &self.qdd,
+            &x.qd,
+            &x.qdd,
             dt,
             0.5 * dt,
             f,
@@ -166,15 +182,15 @@ impl CentralDifference {
         );
     }
 
-    /// Step 5: `q̈_free = A⁻¹ (f − K q − C q̇*)`, written to `self.qdd`.
+    /// Step 5: `q̈_free = A⁻¹ (f − K q − C q̇*)`, written to `x.qdd`.
     #[inline(always)]
-    pub fn free_acceleration(&mut self, force: &[f64]) {
-        self.free_acceleration_with::<Portable>(force)
+    pub fn free_acceleration(&mut self, x: &mut ModalState, force: &[f64]) {
+        self.free_acceleration_with::<Portable>(x, force)
     }
 
-    /// [`Self::free_acceleration`] with the kernels `K` ([`crate::numerics`]).
+    /// [`Self::free_acceleration`] with the kernels `K` ([`crate::kernels`]).
     #[inline(always)]
-    pub(crate) fn free_acceleration_with<K: Lanes>(&mut self, force: &[f64]) {
+    pub(crate) fn free_acceleration_with<K: Lanes>(&mut self, x: &mut ModalState, force: &[f64]) {
         match &mut self.operators {
             Operators::Modal {
                 omega2,
@@ -182,11 +198,11 @@ impl CentralDifference {
                 a_inv,
             } => {
                 K::free_acceleration(
-                    &mut self.qdd,
+                    &mut x.qdd,
                     a_inv,
                     force,
                     omega2,
-                    &self.q,
+                    &x.q,
                     damping,
                     &self.qd_star,
                 );
@@ -198,21 +214,22 @@ impl CentralDifference {
                 work,
                 ..
             } => {
-                residual(force, stiffness, &self.q, damping, &self.qd_star, work);
-                mat_vec(a_inv, work.as_slice(), &mut self.qdd);
+                residual(force, stiffness, &x.q, damping, &self.qd_star, work);
+                mat_vec(a_inv, work.as_slice(), &mut x.qdd);
             }
         }
     }
 
-    /// [`Self::free_acceleration_with`] of the force `force + s x` without forming it
+    /// [`Self::free_acceleration_with`] of the force `force + s row` without forming it
     /// ([`Lanes::free_acceleration_plus`], the same bits); `false`, with nothing done, for
     /// dense operators (the caller then forms the force).
     #[inline(always)]
     pub(crate) fn free_acceleration_plus_with<K: Lanes>(
         &mut self,
+        x: &mut ModalState,
         force: &[f64],
         s: f64,
-        x: &[f64],
+        row: &[f64],
     ) -> bool {
         match &self.operators {
             Operators::Modal {
@@ -221,13 +238,13 @@ impl CentralDifference {
                 a_inv,
             } => {
                 K::free_acceleration_plus(
-                    &mut self.qdd,
+                    &mut x.qdd,
                     a_inv,
                     force,
                     s,
-                    x,
+                    row,
                     omega2,
-                    &self.q,
+                    &x.q,
                     damping,
                     &self.qd_star,
                 );
@@ -253,29 +270,33 @@ impl CentralDifference {
     /// Step 7: full-step velocity; returns, computed in the same pass,
     /// [`Self::energy_and_powers`] of the new state with the modal force `f`.
     #[inline(always)]
-    pub fn correct(&mut self, f: &[f64]) -> (f64, f64, f64) {
-        self.correct_with::<Portable>(f)
+    pub fn correct(&mut self, x: &mut ModalState, f: &[f64]) -> (f64, f64, f64) {
+        self.correct_with::<Portable>(x, f)
     }
 
-    /// [`Self::correct`] with the reduction kernels `K` ([`crate::numerics`]).
+    /// [`Self::correct`] with the reduction kernels `K` ([`crate::kernels`]).
     #[inline(always)]
-    pub(crate) fn correct_with<K: Lanes>(&mut self, f: &[f64]) -> (f64, f64, f64) {
+    pub(crate) fn correct_with<K: Lanes>(
+        &mut self,
+        x: &mut ModalState,
+        f: &[f64],
+    ) -> (f64, f64, f64) {
         let h = 0.5 * self.dt;
         let Operators::Modal {
             omega2, damping, ..
         } = &self.operators
         else {
-            for (v, (vs, a)) in self.qd.iter_mut().zip(self.qd_star.iter().zip(&self.qdd)) {
+            for (v, (vs, a)) in x.qd.iter_mut().zip(self.qd_star.iter().zip(&x.qdd)) {
                 *v = vs + h * a;
             }
-            return self.energy_and_powers(f);
+            return self.energy_and_powers(x, f);
         };
         K::correct_with_energy(
-            &mut self.qd,
+            &mut x.qd,
             &self.qd_star,
-            &self.qdd,
+            &x.qdd,
             h,
-            &self.q,
+            &x.q,
             omega2,
             damping,
             f,
@@ -286,20 +307,20 @@ impl CentralDifference {
     /// power dissipated by damping `q̇ᵀ C q̇`, and the power `fᵀq̇` of the modal force `f`
     /// (THEORY §5, the energy balance).
     #[inline]
-    pub fn energy_and_powers(&self, f: &[f64]) -> (f64, f64, f64) {
+    pub fn energy_and_powers(&self, x: &ModalState, f: &[f64]) -> (f64, f64, f64) {
         match &self.operators {
             Operators::Modal {
                 omega2, damping, ..
-            } => crate::numerics::energy_sums(&self.qd, &self.q, omega2, damping, f),
+            } => crate::numerics::energy_sums(&x.qd, &x.q, omega2, damping, f),
             Operators::Dense {
                 mass,
                 stiffness,
                 damping,
                 ..
             } => (
-                0.5 * (quadratic(mass, &self.qd) + quadratic(stiffness, &self.q)),
-                quadratic(damping, &self.qd),
-                f.iter().zip(&self.qd).map(|(f, v)| f * v).sum(),
+                0.5 * (quadratic(mass, &x.qd) + quadratic(stiffness, &x.q)),
+                quadratic(damping, &x.qd),
+                f.iter().zip(&x.qd).map(|(f, v)| f * v).sum(),
             ),
         }
     }

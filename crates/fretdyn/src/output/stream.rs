@@ -9,8 +9,8 @@
 //!   what a killed run had flushed;
 //! - `impacts.csv`: the per-impact table, appended as impacts end;
 //! - `blocks.csv`: the per-block statistics (the batches of the standard errors: always);
-//! - `checkpoint.bin`: the [`Snapshot`] with the length of every file at that step, written to
-//!   a temporary name and renamed; its format is in [`CHECKPOINT_MAGIC`];
+//! - `checkpoint.bin`: the run's [`Snapshot`](crate::integrator::simulation::Snapshot) with
+//!   the length of every file at that step ([`super::checkpoint`]);
 //! - at the end, `results.npz`, packed from `series/` (copied entry by entry, never whole in
 //!   memory), then (with the `netcdf` feature) `results.nc`, the same arrays with names and
 //!   units, packed from `series/` block by block (`results/netcdf.rs` says why at the
@@ -24,30 +24,29 @@
 //! Memory does not grow with the run's length: the recorder holds one chunk, finished impacts
 //! and blocks are written out at each flush, and the statistics are running sums.
 //!
-//! One concept, kept whole: the files of a streamed run, their chunked writing, the checkpoint
-//! that records their lengths and the resume that truncates them back are one format; none
-//! reads right without the others.
+//! The steps run on the one run loop ([`crate::integrator::simulation::drive`]); what this
+//! file adds is its sink: the flushes, the checkpoints and the progress at the ends of the
+//! batches.
 
 use std::fs::{File, OpenOptions};
-use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
+use std::io::{BufWriter, Seek, SeekFrom, Write};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-use serde::{Deserialize, Serialize};
 
 use crate::accumulate::recorder::Recorder;
 use crate::accumulate::statistics::{BlockStatistics, Impact};
 use crate::error::{Error, Result};
 use crate::integrator::simulation::{
-    Progress, RunResults, RunSettings, Simulation, Snapshot, Termination,
+    BatchEnd, BatchSink, Driven, Progress, RunResults, RunSettings, Simulation, Termination, drive,
 };
 use crate::model::Model;
+use crate::output::checkpoint::{self, Checkpoint};
 pub use crate::output::layout::{
     BLOCKS_FILE, CHECKPOINT_FILE, IMPACTS_FILE, NETCDF_FILE, RESULTS_FILE, ResultsMetadata,
     SERIES_DIR,
 };
-use crate::output::layout::{Dtype, NPY_HEADER};
+use crate::output::series::{NpyAppender, pack_npz, series_layout};
 
 /// How a streamed run writes and checkpoints.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,30 +107,6 @@ fn packed_files() -> &'static [&'static str] {
     }
 }
 
-/// First bytes of `checkpoint.bin`. The file is: these 8 bytes, the format version
-/// ([`CHECKPOINT_FORMAT`], u32 little-endian), the length of the version of fretdyn that
-/// wrote it (u8) and that version (UTF-8, e.g. `0.1.0`), then the checkpoint in CBOR (RFC
-/// 8949; exact for every `f64`). [`resume`] refuses a checkpoint of another format or another
-/// version of fretdyn: a resumed run gives the results of an uninterrupted one only with the
-/// code that started it.
-pub const CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNC";
-
-/// Format version of `checkpoint.bin` (1 was bincode, without a header; 2 counted the
-/// statistics' steps per contact and accumulated blocks when there were none; 4 had blocks
-/// only when set, and no batch moments; 5 had the angle of an impact's peak formed at the
-/// peak, not its direction).
-pub const CHECKPOINT_FORMAT: u32 = 6;
-
-#[derive(Serialize, Deserialize)]
-struct Checkpoint {
-    fingerprint: u64,
-    snapshot: Snapshot,
-    /// Rows in every series file at the checkpoint.
-    rows: u64,
-    impacts_bytes: u64,
-    blocks_bytes: u64,
-}
-
 /// Runs `model` and streams its results into `dir` (created if needed). `fingerprint`
 /// identifies the case (e.g. a hash of the case file): [`resume`] refuses a checkpoint made
 /// for another one.
@@ -149,7 +124,7 @@ pub fn run(
     let _ = std::fs::remove_file(dir.join(RESULTS_FILE));
     let _ = std::fs::remove_file(dir.join(NETCDF_FILE));
     let files = Files::create(dir, model)?;
-    drive(sim, files, settings, stream, fingerprint, observer)
+    streamed(sim, files, settings, stream, fingerprint, observer)
 }
 
 /// Continues the run streamed into `dir` from its last checkpoint, with the same model and
@@ -162,7 +137,7 @@ pub fn resume(
     fingerprint: u64,
     observer: &mut dyn StreamObserver,
 ) -> Result<RunResults> {
-    let checkpoint = read_checkpoint(dir)?;
+    let checkpoint = checkpoint::read(dir)?;
     let path = dir.join(CHECKPOINT_FILE);
     if checkpoint.fingerprint != fingerprint_with(fingerprint, settings) {
         return Err(Error::invalid(
@@ -174,7 +149,7 @@ pub fn resume(
         ));
     }
     let ended =
-        checkpoint.snapshot.step >= settings.steps || checkpoint.snapshot.target_met().is_some();
+        checkpoint.snapshot.step() >= settings.steps || checkpoint.snapshot.target_met().is_some();
     if ended && packed_files().iter().all(|f| dir.join(f).exists()) {
         // killed while removing series/, after the packing: what is left is not needed
         let _ = std::fs::remove_dir_all(dir.join(SERIES_DIR));
@@ -204,140 +179,48 @@ pub fn resume(
             _ => {}
         }
     }
-    drive(sim, files, settings, stream, fingerprint, observer)
+    streamed(sim, files, settings, stream, fingerprint, observer)
 }
 
-/// Reads the checkpoint of the run in `dir`; an error says why it cannot be resumed.
-fn read_checkpoint(dir: &Path) -> Result<Checkpoint> {
-    let path = dir.join(CHECKPOINT_FILE);
-    let bytes = match std::fs::read(&path) {
-        Ok(bytes) => bytes,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(Error::invalid(
-                "checkpoint",
-                format!(
-                    "{}: the run stopped before its first checkpoint, there is nothing to \
-                     resume: start it again",
-                    dir.display()
-                ),
-            ));
-        }
-        Err(e) => return Err(Error::io(&path, e)),
-    };
-    decode_checkpoint(&bytes)
-        .map_err(|message| Error::invalid("checkpoint", format!("{}: {message}", path.display())))
-}
-
-/// The step of the last checkpoint of the run in `dir` (the steps a resumed run starts after).
-pub fn checkpoint_step(dir: &Path) -> Result<u64> {
-    Ok(read_checkpoint(dir)?.snapshot.step)
-}
-
-fn encode_checkpoint(checkpoint: &Checkpoint) -> std::io::Result<Vec<u8>> {
-    let version = env!("CARGO_PKG_VERSION").as_bytes();
-    let mut bytes = Vec::with_capacity(4096);
-    bytes.extend_from_slice(CHECKPOINT_MAGIC);
-    bytes.extend_from_slice(&CHECKPOINT_FORMAT.to_le_bytes());
-    bytes.push(version.len() as u8);
-    bytes.extend_from_slice(version);
-    ciborium::into_writer(checkpoint, &mut bytes).map_err(std::io::Error::other)?;
-    Ok(bytes)
-}
-
-/// Decodes [`encode_checkpoint`]; the error says what is wrong and what to do.
-fn decode_checkpoint(bytes: &[u8]) -> std::result::Result<Checkpoint, String> {
-    let start_again = "start the run again";
-    let Some(rest) = bytes.strip_prefix(CHECKPOINT_MAGIC) else {
-        return Err(format!(
-            "not a checkpoint of this fretdyn (an older checkpoint format without a header, or \
-             another file): {start_again}"
-        ));
-    };
-    let truncated = || format!("truncated: {start_again}");
-    let format = u32::from_le_bytes(
-        rest.get(..4)
-            .and_then(|b| b.try_into().ok())
-            .ok_or_else(truncated)?,
-    );
-    let len = *rest.get(4).ok_or_else(truncated)? as usize;
-    let version = rest.get(5..5 + len).ok_or_else(truncated)?;
-    let version = String::from_utf8_lossy(version);
-    let ours = env!("CARGO_PKG_VERSION");
-    if format != CHECKPOINT_FORMAT || version != ours {
-        return Err(format!(
-            "written by fretdyn {version} (checkpoint format {format}), this is fretdyn {ours} \
-             (format {CHECKPOINT_FORMAT}): resume it with fretdyn {version}, or {start_again}"
-        ));
-    }
-    ciborium::from_reader(&rest[5 + len..]).map_err(|e| format!("damaged ({e}): {start_again}"))
-}
-
-/// The step loop of a streamed run.
-fn drive(
-    mut sim: Simulation,
-    mut files: Files,
+/// A streamed run from `sim` into `files`: the run loop with the [`Streamed`] sink, then the
+/// run's end — the last flush and checkpoint, the observer's [`StreamObserver::finished`],
+/// the packing.
+fn streamed(
+    sim: Simulation,
+    files: Files,
     settings: &RunSettings,
     stream: &StreamSettings,
     fingerprint: u64,
     observer: &mut dyn StreamObserver,
 ) -> Result<RunResults> {
-    let fingerprint = fingerprint_with(fingerprint, settings);
-    let start = Instant::now();
-    let mut last_checkpoint = Instant::now();
-    let total = settings.steps;
-    let mut termination = Termination::Completed;
-    let model = files.model_contacts.clone();
-    while sim.steps_done() < total && sim.target_met().is_none() {
-        // to the end of the batch or the next multiple of the checkpoints' steps, where the
-        // loop below looks at the clock and the observer
-        let n = sim.steps_done();
-        let mut chunk = sim.steps_to_batch_end(total);
-        if let Some(every) = stream.checkpoint_every_steps.filter(|&e| e > 0) {
-            chunk = chunk.min(every - n % every);
-        }
-        if let Err(d) = sim.steps(chunk) {
-            termination = Termination::Diverged {
-                step: d.step,
-                time: d.time,
-                contact: d.contact.map(|c| model[c].clone()),
-            };
-            break;
-        }
-        if sim.recorder().is_full() {
-            files.flush(&mut sim)?;
-        }
-        let n = sim.steps_done();
-        let by_steps = stream
-            .checkpoint_every_steps
-            .is_some_and(|every| every > 0 && n.is_multiple_of(every));
-        if n.is_multiple_of(Simulation::BATCH) || by_steps {
-            let by_time = stream
-                .checkpoint_every_seconds
-                .is_some_and(|s| last_checkpoint.elapsed().as_secs_f64() >= s);
-            if (by_steps || by_time) && n < total {
-                files.checkpoint(&mut sim, fingerprint)?;
-                last_checkpoint = Instant::now();
-                observer.checkpoint(&partial(&sim, start));
-            }
-            if n.is_multiple_of(Simulation::BATCH)
-                && n < total
-                && observer.progress(Progress { step: n, total }).is_break()
-            {
-                termination = Termination::Stopped { step: n };
-                break;
-            }
-        }
-    }
+    let mut sink = Streamed {
+        files,
+        stream,
+        fingerprint: fingerprint_with(fingerprint, settings),
+        observer,
+        start: Instant::now(),
+        last_checkpoint: Instant::now(),
+    };
     // the step loop's time (RunResults::wall_time): the last flush and checkpoint are the
     // run's output, as the set-up is its input
-    let wall_time = start.elapsed().as_secs_f64();
+    let Driven {
+        mut sim,
+        termination,
+        wall_time,
+    } = drive(sim, &mut sink)?;
+    let Streamed {
+        mut files,
+        fingerprint,
+        observer,
+        ..
+    } = sink;
     files.flush(&mut sim)?;
     if !matches!(termination, Termination::Diverged { .. }) {
         files.checkpoint(&mut sim, fingerprint)?;
     }
     let _ = observer.progress(Progress {
         step: sim.steps_done(),
-        total,
+        total: settings.steps,
     });
     let mut results = sim.finish(wall_time, termination);
     // impacts in progress and the last partial block, ended with the run
@@ -354,18 +237,48 @@ fn drive(
     Ok(results)
 }
 
-/// A zip error as the I/O error it is (a full disk says "No space left on device", not "i/o
-/// error"), or wrapped.
-fn zip_io(e: zip::result::ZipError) -> std::io::Error {
-    match e {
-        zip::result::ZipError::Io(e) => e,
-        other => std::io::Error::other(other),
-    }
+/// What a streamed run does at the ends of its batches: the recorder flushed when full, a
+/// checkpoint every so many steps or seconds, the progress told to the observer.
+struct Streamed<'a> {
+    files: Files,
+    stream: &'a StreamSettings,
+    /// [`fingerprint_with`] of the case and the settings.
+    fingerprint: u64,
+    observer: &'a mut dyn StreamObserver,
+    /// When the step loop started.
+    start: Instant,
+    last_checkpoint: Instant,
 }
 
-/// Statistics so far, without touching the run.
-fn partial(sim: &Simulation, start: Instant) -> RunResults {
-    sim.partial_results(start.elapsed().as_secs_f64())
+impl BatchSink for Streamed<'_> {
+    fn every_steps(&self) -> Option<u64> {
+        self.stream.checkpoint_every_steps
+    }
+
+    fn drain(&mut self, sim: &mut Simulation) -> Result<()> {
+        self.files.flush(sim)
+    }
+
+    fn batch_end(&mut self, sim: &mut Simulation, end: BatchEnd) -> Result<ControlFlow<()>> {
+        let by_time = self
+            .stream
+            .checkpoint_every_seconds
+            .is_some_and(|s| self.last_checkpoint.elapsed().as_secs_f64() >= s);
+        if (end.by_steps || by_time) && end.before_the_end() {
+            self.files.checkpoint(sim, self.fingerprint)?;
+            self.last_checkpoint = Instant::now();
+            let partial = sim.partial_results(self.start.elapsed().as_secs_f64());
+            self.observer.checkpoint(&partial);
+        }
+        Ok(if end.whole && end.before_the_end() {
+            self.observer.progress(Progress {
+                step: end.step,
+                total: end.total,
+            })
+        } else {
+            ControlFlow::Continue(())
+        })
+    }
 }
 
 fn fingerprint_with(fingerprint: u64, settings: &RunSettings) -> u64 {
@@ -379,21 +292,6 @@ pub fn fnv1a<'a>(bytes: impl IntoIterator<Item = &'a u8>) -> u64 {
     bytes.into_iter().fold(0xcbf29ce484222325, |h, b| {
         (h ^ *b as u64).wrapping_mul(0x100000001b3)
     })
-}
-
-/// The series: key, element type, shape of one row.
-fn series_layout(p: usize, c: usize) -> [(&'static str, Dtype, Vec<usize>); 9] {
-    [
-        ("t", Dtype::F64, vec![]),
-        ("q", Dtype::F64, vec![p]),
-        ("qdot", Dtype::F64, vec![p]),
-        ("contact_normal_force", Dtype::F64, vec![c]),
-        ("contact_tangential_force", Dtype::F64, vec![c, 2]),
-        ("contact_slip_velocity", Dtype::F64, vec![c, 2]),
-        ("contact_penetration", Dtype::F64, vec![c]),
-        ("contact_status", Dtype::I8, vec![c]),
-        ("contact_position", Dtype::F64, vec![c, 2]),
-    ]
 }
 
 /// The open files of a streamed run.
@@ -601,12 +499,7 @@ impl Files {
             impacts_bytes,
             blocks_bytes,
         };
-        let bytes = encode_checkpoint(&checkpoint)
-            .map_err(|e| Error::io(self.dir.join(CHECKPOINT_FILE), e))?;
-        crate::files::write_atomically(&self.dir.join(CHECKPOINT_FILE), |mut f| {
-            f.write_all(&bytes)?;
-            f.sync_data()
-        })
+        checkpoint::write(&self.dir, &checkpoint)
     }
 
     /// Packs `series/` into `results.npz` (stored entries, copied file by file), then with
@@ -619,21 +512,7 @@ impl Files {
             .iter()
             .map(|s| (s.key.clone(), s.path.clone()))
             .collect();
-        crate::files::write_atomically(&path, |file| {
-            // after an error (a full disk), the writer swallows what the ZipWriter's drop
-            // writes: the error is reported once, by the caller, and the file removed
-            let mut zip = zip::ZipWriter::new(BufWriter::new(FailOnce::new(file)));
-            let options = zip::write::SimpleFileOptions::default()
-                .compression_method(zip::CompressionMethod::Stored)
-                .large_file(true);
-            for (key, p) in &series {
-                zip.start_file(format!("{key}.npy"), options)
-                    .map_err(zip_io)?;
-                let mut f = File::open(p)?;
-                std::io::copy(&mut f, &mut zip)?;
-            }
-            zip.finish().map_err(zip_io)?.flush()
-        })?;
+        pack_npz(&path, &series)?;
         #[cfg(feature = "netcdf")]
         {
             let series: Vec<crate::output::netcdf::SeriesFile> = self
@@ -656,61 +535,6 @@ impl Files {
             let _ = std::fs::remove_dir_all(self.dir.join(SERIES_DIR));
         }
         Ok(())
-    }
-}
-
-/// A file that, once a write, flush or seek failed, accepts everything silently: for the
-/// [`zip::ZipWriter`], which on drop tries to finish the archive after an error and prints
-/// that second failure.
-struct FailOnce {
-    file: File,
-    failed: bool,
-}
-
-impl FailOnce {
-    fn new(file: File) -> Self {
-        Self {
-            file,
-            failed: false,
-        }
-    }
-
-    fn guard<T>(&mut self, r: std::io::Result<T>, instead: T) -> std::io::Result<T> {
-        if self.failed {
-            return Ok(instead);
-        }
-        if r.is_err() {
-            self.failed = true;
-        }
-        r
-    }
-}
-
-impl Write for FailOnce {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        if self.failed {
-            return Ok(buf.len());
-        }
-        let r = self.file.write(buf);
-        self.guard(r, buf.len())
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        if self.failed {
-            return Ok(());
-        }
-        let r = self.file.flush();
-        self.guard(r, ())
-    }
-}
-
-impl Seek for FailOnce {
-    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
-        if self.failed {
-            return Ok(0);
-        }
-        let r = self.file.seek(pos);
-        self.guard(r, 0)
     }
 }
 
@@ -740,128 +564,4 @@ fn reopen_at(path: &Path, len: u64) -> Result<BufWriter<File>> {
     file.set_len(len).map_err(io)?;
     file.seek(SeekFrom::Start(len)).map_err(io)?;
     Ok(BufWriter::new(file))
-}
-
-/// A `.npy` file (format 1.0) that grows by rows.
-struct NpyAppender {
-    key: String,
-    path: PathBuf,
-    file: BufWriter<File>,
-    dtype: Dtype,
-    row_shape: Vec<usize>,
-    /// Values per row.
-    row_len: usize,
-    rows: u64,
-}
-
-impl NpyAppender {
-    fn create(path: &Path, dtype: Dtype, row_shape: Vec<usize>) -> Result<Self> {
-        let file = File::create(path).map_err(|e| Error::io(path, e))?;
-        let mut s = Self::new(path, file, dtype, row_shape, 0);
-        s.write_header()?;
-        Ok(s)
-    }
-
-    /// Reopens a file written by [`Self::create`], cut to `rows` rows.
-    fn reopen(path: &Path, dtype: Dtype, row_shape: Vec<usize>, rows: u64) -> Result<Self> {
-        let io = |e| Error::io(path, e);
-        let mut file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .open(path)
-            .map_err(io)?;
-        let mut magic = [0u8; 6];
-        file.read_exact(&mut magic).map_err(io)?;
-        let mut s = Self::new(path, file, dtype, row_shape, rows);
-        let len = NPY_HEADER as u64 + rows * s.row_len as u64 * dtype.size();
-        if &magic != b"\x93NUMPY" || s.file.get_ref().metadata().map_err(io)?.len() < len {
-            return Err(Error::invalid(
-                "checkpoint",
-                format!(
-                    "{} is shorter than at the checkpoint: the run folder was changed",
-                    path.display()
-                ),
-            ));
-        }
-        s.file.get_mut().set_len(len).map_err(io)?;
-        s.write_header()?;
-        Ok(s)
-    }
-
-    fn new(path: &Path, file: File, dtype: Dtype, row_shape: Vec<usize>, rows: u64) -> Self {
-        let key = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        Self {
-            key,
-            path: path.to_path_buf(),
-            file: BufWriter::with_capacity(1 << 16, file),
-            dtype,
-            row_len: row_shape.iter().product(),
-            row_shape,
-            rows,
-        }
-    }
-
-    /// Writes the header for the rows written so far, then goes back to the end.
-    fn write_header(&mut self) -> Result<()> {
-        let mut shape = self.rows.to_string();
-        for d in &self.row_shape {
-            shape.push_str(&format!(", {d}"));
-        }
-        if self.row_shape.is_empty() {
-            shape.push(',');
-        }
-        let dict = format!(
-            "{{'descr': '{}', 'fortran_order': False, 'shape': ({shape}), }}",
-            self.dtype.descr()
-        );
-        let mut header = Vec::with_capacity(NPY_HEADER);
-        header.extend_from_slice(b"\x93NUMPY\x01\x00");
-        header.extend_from_slice(&((NPY_HEADER - 10) as u16).to_le_bytes());
-        header.extend_from_slice(dict.as_bytes());
-        header.resize(NPY_HEADER - 1, b' ');
-        header.push(b'\n');
-        let io = |e| Error::io(&self.path, e);
-        self.file.flush().map_err(io)?;
-        let f = self.file.get_mut();
-        f.seek(SeekFrom::Start(0)).map_err(io)?;
-        f.write_all(&header).map_err(io)?;
-        f.seek(SeekFrom::End(0)).map_err(io)?;
-        Ok(())
-    }
-
-    /// Appends `rows` rows (`values` holds `rows × row_len` values: none for a row of
-    /// length 0, e.g. the contact arrays of a model without contacts).
-    fn append_f64(&mut self, values: &[f64], rows: usize) -> Result<()> {
-        debug_assert_eq!(self.dtype, Dtype::F64);
-        debug_assert_eq!(values.len(), rows * self.row_len);
-        for v in values {
-            self.file
-                .write_all(&v.to_le_bytes())
-                .map_err(|e| Error::io(&self.path, e))?;
-        }
-        self.rows += rows as u64;
-        self.write_header()
-    }
-
-    /// As [`Self::append_f64`].
-    fn append_i8(&mut self, values: &[i8], rows: usize) -> Result<()> {
-        debug_assert_eq!(self.dtype, Dtype::I8);
-        debug_assert_eq!(values.len(), rows * self.row_len);
-        let bytes: Vec<u8> = values.iter().map(|v| *v as u8).collect();
-        self.file
-            .write_all(&bytes)
-            .map_err(|e| Error::io(&self.path, e))?;
-        self.rows += rows as u64;
-        self.write_header()
-    }
-
-    fn sync(&mut self) -> Result<()> {
-        self.file
-            .flush()
-            .and_then(|_| self.file.get_ref().sync_data())
-            .map_err(|e| Error::io(&self.path, e))
-    }
 }

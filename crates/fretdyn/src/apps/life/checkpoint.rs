@@ -64,8 +64,9 @@ pub struct LifeCheckpoint {
 /// First bytes of a service life's checkpoint.
 pub const LIFE_CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNL";
 
-/// Format version of a service life's checkpoint.
-pub const LIFE_CHECKPOINT_FORMAT: u32 = 1;
+/// Format version of a service life's checkpoint (1: the window's wear map beside its
+/// simulation's hand-kept snapshot).
+pub const LIFE_CHECKPOINT_FORMAT: u32 = 2;
 
 impl LifeCheckpoint {
     /// Reads the checkpoint at `path`; the error says why it cannot be resumed.

@@ -6,7 +6,6 @@ use std::ops::ControlFlow;
 
 use serde::{Deserialize, Serialize};
 
-use crate::accumulate::wear_map::WearMap;
 use crate::case::Case;
 use crate::error::Result;
 use crate::integrator::simulation::statistics_run_from;
@@ -32,12 +31,11 @@ pub(super) enum WindowEnd {
     Stopped(Box<WindowProgress>),
 }
 
-/// A window under way: its simulation's state and where its wear work was done so far, at
-/// the end of a batch of steps (a checkpoint inside a long window).
+/// A window under way: its simulation's state, where its wear work was done so far
+/// included, at the end of a batch of steps (a checkpoint inside a long window).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub(super) struct WindowProgress {
     pub(super) snapshot: Snapshot,
-    pub(super) map: WearMap,
 }
 
 /// Runs one window of `model`, tracking where the friction work is done, from its start or
@@ -57,25 +55,18 @@ pub(super) fn window(
             sim.track_wear(bins);
             sim
         }
-        Some(p) => {
-            let mut sim = Simulation::resume(model, &case.settings, p.snapshot, 1)?;
-            sim.track_wear_from(p.map);
-            sim
-        }
+        Some(p) => Simulation::resume(model, &case.settings, p.snapshot, 1)?,
     };
     let mut stopped = None;
-    let (results, map) = statistics_run_from(sim, &case.settings, &mut |sim| {
+    let (results, map) = statistics_run_from(sim, &mut |sim| {
         let here = || WindowProgress {
             snapshot: sim.snapshot(),
-            map: sim.wear_map().cloned().expect("tracked"),
         };
-        match at_batch(&here) {
-            ControlFlow::Continue(()) => ControlFlow::Continue(()),
-            ControlFlow::Break(()) => {
-                stopped = Some(here());
-                ControlFlow::Break(sim.steps_done())
-            }
+        let flow = at_batch(&here);
+        if flow.is_break() {
+            stopped = Some(here());
         }
+        flow
     })?;
     if let Some(progress) = stopped {
         return Ok(WindowEnd::Stopped(Box::new(progress)));

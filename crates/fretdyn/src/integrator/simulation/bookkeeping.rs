@@ -1,12 +1,11 @@
-//! Phase 4 of a step — the bookkeeping: energy and powers for the balance, the output
-//! sample, the per-contact values for the statistics, and the results (THEORY §5).
+//! Phase 5 of a step — the bookkeeping: energy and powers for the balance, the output
+//! sample, the window's opening, the wear work's map, and the results (THEORY §5).
 
 use super::contact_kinds::ContactKinds;
-use super::{ContactState, RunResults, Simulation, Termination};
+use super::results::{RunResults, Termination};
+use super::step::Simulation;
+use super::workspace::contact_rows;
 use crate::accumulate::recorder::{ContactSample, Recorder};
-use crate::accumulate::statistics::{ContactStep, StepValues};
-use crate::contact::frame_rows::FrameRows;
-use crate::contact::friction::Slide;
 use crate::numerics::Lanes;
 use crate::structure::modal::recombine;
 
@@ -22,16 +21,16 @@ impl Simulation<'_> {
     ) -> (f64, [f64; 5]) {
         let (mut e, modal_damping, mut external) = modal;
         // the external force holds the fluid-elastic one: its power apart
-        let fluid = match &self.fluid {
-            Some(f) => K::dot(&f.force, &self.cd.qd),
+        let fluid = match &self.work.fluid {
+            Some(f) => K::dot(&f.force, &self.state.modal.qd),
             None => 0.0,
         };
         external -= fluid;
         let mut contact_damping = 0.0;
         let mut tangential = 0.0;
         let mut obstacle = 0.0;
-        for &k in &self.closed {
-            let (c, s) = (&self.model.contacts[k], &self.contacts[k]);
+        for &k in &self.work.closed {
+            let (c, s) = (&self.model.contacts[k], &self.state.contacts[k]);
             let d = s.frame.penetration;
             e += 0.5 * c.normal.stiffness * d * d;
             if O::damped(c) {
@@ -60,21 +59,18 @@ impl Simulation<'_> {
     /// velocity or position is not finite (the modal state and the forces are checked by
     /// [`Self::step`] already).
     pub(super) fn sample(&mut self) -> Option<usize> {
-        let t = self.step as f64 * self.settings.dt;
-        if !self.recorder.push_state(t, &self.cd.q, &self.cd.qd) {
+        let t = self.state.step as f64 * self.settings.dt;
+        let x = &self.state.modal;
+        if !self.recorder.push_state(t, &x.q, &x.qd) {
             return None;
         }
         let mut non_finite = None;
-        for (k, (s, c)) in self
-            .contacts
-            .iter_mut()
-            .zip(&self.model.contacts)
-            .enumerate()
-        {
-            if self.frame_rows[k].is_some() {
+        let states = self.state.contacts.iter_mut();
+        for (k, (s, c)) in states.zip(&self.model.contacts).enumerate() {
+            if self.work.frame_rows[k].is_some() {
                 // a plane's or bars' 3-D position is formed for the samples only
                 let pt = &self.model.basis.points[c.point];
-                s.x = pt.coords + recombine(&pt.rows, &self.cd.q);
+                s.x = pt.coords + recombine(&pt.rows, &x.q);
             }
             let vt = s.tangential_velocity();
             let local = c.local(&s.x, t);
@@ -105,41 +101,65 @@ impl Simulation<'_> {
     #[cold]
     #[inline(never)]
     pub(super) fn open_statistics_window(&mut self) {
-        let t = self.step as f64 * self.settings.dt;
-        let (model, surface_rows, qd) = (self.model, &self.surface_rows, &self.cd.qd);
-        let speeds = self.contacts.iter().enumerate().map(|(k, s)| {
+        let t = self.state.step as f64 * self.settings.dt;
+        let (model, surface_rows, qd) = (self.model, &self.work.surface_rows, &self.state.modal.qd);
+        let speeds = self.state.contacts.iter().enumerate().map(|(k, s)| {
             if !s.closed {
                 return 0.0;
             }
-            let rows = super::contact_rows(model, surface_rows, k);
+            let rows = contact_rows(model, surface_rows, k);
             -s.frame
                 .normal
                 .dot(&(recombine(rows, qd) - s.frame.velocity))
         });
-        self.statistics.open_window(t, speeds);
+        self.state.statistics.open_window(t, speeds);
+    }
+
+    /// Adds the step ending at `t` to the wear map ([`Self::track_wear`]): the friction work
+    /// of the closed contacts, when the step is in the statistics window.
+    #[inline(never)]
+    pub(super) fn track_wear_step(&mut self, t: f64) {
+        let dt = self.settings.dt;
+        let Some(map) = &mut self.state.wear_map else {
+            return;
+        };
+        if !self.settings.statistics.step_in_window(t, dt) {
+            return;
+        }
+        let contacts = self.state.contacts.iter().zip(&self.model.contacts);
+        for (k, ((s, c), rows)) in contacts.zip(&self.work.frame_rows).enumerate() {
+            if s.closed {
+                map.add(k, &s.values(c, rows.as_ref(), t), dt);
+            }
+        }
     }
 
     /// The statistics so far, without ending the run (its recorder is empty).
     pub fn partial_results(&self, wall_time: f64) -> RunResults {
-        let mut statistics = self.statistics.clone();
-        let contacts = statistics.finish(&self.settings.statistics, &self.names, self.settings.dt);
+        let state = &self.state;
+        let mut statistics = state.statistics.clone();
+        let contacts = statistics.finish(
+            &self.settings.statistics,
+            &self.work.names,
+            self.settings.dt,
+        );
         RunResults {
-            recorder: Recorder::new(0, self.cd.q.len(), self.contacts.len()),
+            recorder: Recorder::new(0, state.modal.q.len(), state.contacts.len()),
             contacts,
             impacts: Vec::new(),
             blocks: Vec::new(),
-            solver: self.solver_stats.clone(),
+            solver: state.solver.clone(),
             energy: {
-                let mut energy = self.energy.clone();
+                let mut energy = state.energy.clone();
                 energy.settle();
                 energy
             },
-            steps: self.step,
+            steps: state.step,
             dt: self.settings.dt,
-            stable_dt: self.stable_dt,
+            stable_dt: self.work.stable_dt,
             wall_time,
-            termination: Termination::InProgress { step: self.step },
-            target_met_at: self.statistics.target_met(),
+            termination: Termination::InProgress { step: state.step },
+            target_met_at: state.statistics.target_met(),
         }
     }
 
@@ -148,105 +168,27 @@ impl Simulation<'_> {
     pub fn finish(mut self, wall_time: f64, termination: Termination) -> RunResults {
         self.recorder.truncate();
         let dt = self.settings.dt;
-        let steps = self.step;
-        let stable_dt = self.stable_dt;
-        let contacts = self
-            .statistics
-            .finish(&self.settings.statistics, &self.names, dt);
-        self.energy.settle();
-        let mut blocks = std::mem::take(&mut self.statistics.blocks);
-        crate::accumulate::statistics::name_blocks(&mut blocks, &self.names);
+        let mut state = self.state;
+        let names = &self.work.names;
+        let steps = state.step;
+        let stable_dt = self.work.stable_dt;
+        let contacts = (state.statistics).finish(&self.settings.statistics, names, dt);
+        state.energy.settle();
+        let mut blocks = std::mem::take(&mut state.statistics.blocks);
+        crate::accumulate::statistics::name_blocks(&mut blocks, names);
         RunResults {
-            target_met_at: self.statistics.target_met(),
+            target_met_at: state.statistics.target_met(),
             contacts,
-            impacts: std::mem::take(&mut self.statistics.impacts),
+            impacts: std::mem::take(&mut state.statistics.impacts),
             blocks,
             recorder: self.recorder,
-            solver: self.solver_stats,
-            energy: self.energy,
+            solver: state.solver,
+            energy: state.energy,
             steps,
             dt,
             stable_dt,
             wall_time,
             termination,
         }
-    }
-}
-
-/// One contact's step ending at `t` for the statistics (THEORY §5): an open contact's offset
-/// and penetration, or a closed one's [`step_values`].
-#[inline(always)]
-pub(super) fn contact_step(
-    s: &ContactState,
-    c: &crate::contact::Contact,
-    rows: Option<&FrameRows>,
-    t: f64,
-) -> ContactStep {
-    if s.closed {
-        ContactStep::Closed(step_values(s, c, rows, t))
-    } else {
-        ContactStep::Open {
-            radial: offset(s, c, rows, t).0,
-            penetration: s.frame.penetration,
-        }
-    }
-}
-
-/// The offset of contact `s` and its direction ([`StepValues::radial`],
-/// [`StepValues::direction`]).
-#[inline(always)]
-fn offset(
-    s: &ContactState,
-    c: &crate::contact::Contact,
-    rows: Option<&FrameRows>,
-    t: f64,
-) -> (f64, [f64; 2]) {
-    if rows.is_some() {
-        // a plane or bars: the distance from the (mid-)plane, THEORY §5
-        (s.distance, [1.0, 0.0])
-    } else if c.obstacle.is_hole() {
-        let local = c.local(&s.x, t);
-        let r = local.norm();
-        let unit = if r > 0.0 {
-            [local.x / r, local.y / r]
-        } else {
-            [1.0, 0.0]
-        };
-        (r, unit)
-    } else {
-        (c.local(&s.x, t).x, [1.0, 0.0])
-    }
-}
-
-/// One contact's values of the step ending at `t`, for the statistics (THEORY §5).
-#[inline(always)]
-pub(super) fn step_values(
-    s: &ContactState,
-    c: &crate::contact::Contact,
-    rows: Option<&FrameRows>,
-    t: f64,
-) -> StepValues {
-    let (radial, direction) = offset(s, c, rows, t);
-    let (slip_speed, friction_power, tangential) = if s.closed {
-        let vt = s.tangential_velocity();
-        (
-            vt.norm(),
-            s.tangential_force.dot(&vt).abs(),
-            s.tangential_force.norm(),
-        )
-    } else {
-        (0.0, 0.0, 0.0)
-    };
-    StepValues {
-        t,
-        closed: s.closed,
-        stick: s.slide == Slide::Stick,
-        normal: s.normal_force,
-        tangential,
-        slip_speed,
-        friction_power,
-        penetration: s.frame.penetration,
-        radial,
-        direction,
     }
 }

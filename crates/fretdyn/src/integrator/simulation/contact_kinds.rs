@@ -29,10 +29,11 @@ pub(super) trait ContactKinds {
         if Self::COMMON {
             debug_assert!(rows.is_some());
             // SAFETY: the step runs under `CommonContacts` only when every contact has frame
-            // rows (`Simulation::steps` dispatches on `common_contacts`, set from [`is_common`]
-            // when the simulation is allocated, in its only constructor), and a simulation's
-            // frame rows never change. The trait is private to the step's module, whose phases are
-            // called from that dispatch only (its start runs under `AnyContacts`).
+            // rows (`Simulation::steps` dispatches on the workspace's `common_contacts`, set
+            // from [`is_common`] in `Workspace::new`, its only constructor, and only ever
+            // cleared after), and a workspace's frame rows never change. The trait is private
+            // to the step's module, whose phases are called from that dispatch only (its start
+            // runs under `AnyContacts`).
             Some(unsafe { rows.as_ref().unwrap_unchecked() })
         } else {
             rows.as_ref()

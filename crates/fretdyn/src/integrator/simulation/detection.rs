@@ -1,7 +1,6 @@
-//! Phase 1 of a step — the loads and the kinematics: the external modal force at `t`, the
-//! contact points' penetrations, frames and velocities, and the normal penalty forces that
-//! follow from them (THEORY §2 step 3, §3, §7, §8); after the step, the full-step
-//! velocities.
+//! Phase 2 of a step — the detection: the contact points' penetrations, frames and
+//! velocities, and the normal penalty forces that follow from them (THEORY §2 step 3, §3,
+//! §7, §8); after the step, the full-step velocities.
 //!
 //! A plane or bars ([`FrameRows`]) is detected with one dot product on the modal
 //! displacements (in the common case of four contacts or more, all of them in one pass over
@@ -12,86 +11,14 @@
 use nalgebra::{Vector2, Vector3};
 
 use super::contact_kinds::{CommonContacts, ContactKinds};
-use super::{ContactState, Simulation, Tangential, contact_rows, contact_states};
+use super::contact_state::{ContactState, contact_states};
+use super::step::Simulation;
+use super::workspace::{Tangential, contact_rows};
 use crate::contact::frame_rows::FrameRows;
 use crate::numerics::Lanes;
 use crate::structure::modal::recombine_with;
 
 impl Simulation<'_> {
-    /// The external modal force of step `n`, at `t = n Δt`: `Σ_l s_l(t) Φ_lᵀ F_l` over the
-    /// loads' rows (the histories' sines rotated from step to step, THEORY §10), plus the
-    /// turbulence (THEORY §10). The step forms the first load's with the predictor instead
-    /// ([`Self::predict_with_first_load`]).
-    #[inline(always)]
-    pub(super) fn external_force<K: Lanes>(&mut self, n: u64, t: f64) {
-        let p = self.external.len();
-        // the first load sets the force, the others add to it
-        match self.load_histories.first_mut() {
-            Some(first) => K::scale(&mut self.external, first.value(n, t), &self.load_rows[..p]),
-            None => self.external.fill(0.0),
-        }
-        self.other_loads::<K>(n, t);
-    }
-
-    /// Steps 1–2 (the predictor) of step `n` and, in the same pass over the modes, the first
-    /// load's force: the start of [`Self::external_force`] (the same bits), which
-    /// [`Self::other_loads`] completes.
-    #[inline(always)]
-    pub(super) fn predict_with_first_load<K: Lanes>(&mut self, n: u64, t: f64) {
-        let p = self.external.len();
-        match self.load_histories.first_mut() {
-            Some(first) => {
-                let s = first.value(n, t);
-                self.cd
-                    .predict_and_scale_with::<K>(&mut self.external, s, &self.load_rows[..p]);
-            }
-            None => {
-                self.cd.predict_with::<K>();
-                self.external.fill(0.0);
-            }
-        }
-    }
-
-    /// The loads after the first and the turbulence, added to the external force.
-    #[inline(always)]
-    pub(super) fn other_loads<K: Lanes>(&mut self, n: u64, t: f64) {
-        let p = self.external.len();
-        // (one load, the common case, skips the set-up of the loop: its rows' count is a
-        // division)
-        if self.load_histories.len() > 1 {
-            for (history, row) in self.load_histories[1..]
-                .iter_mut()
-                .zip(self.load_rows[p..].chunks_exact(p.max(1)))
-            {
-                K::axpy(&mut self.external, history.value(n, t), row);
-            }
-        }
-        if self.turbulence.is_empty() {
-            return;
-        }
-        for (load, generator) in self.model.turbulence.iter().zip(&mut self.turbulence) {
-            let r = generator.channels();
-            let xi = &mut self.signals[..r];
-            generator.values(t, xi);
-            for (x, row) in xi.iter().zip(load.rows.chunks_exact(p.max(1))) {
-                K::axpy(&mut self.external, *x, row);
-            }
-        }
-    }
-
-    /// The fluid-elastic force of step `n` added to the external force (THEORY §13): the
-    /// displacement of the step is stored for the delays; the velocity is extrapolated from
-    /// the previous step's (`started`), or is the initial one.
-    #[inline(always)]
-    pub(super) fn fluid_elastic_force<K: Lanes>(&mut self, n: u64, started: bool) {
-        let (Some(fluid), Some(fe)) = (&mut self.fluid, &self.model.fluid_elastic) else {
-            return;
-        };
-        fluid.record(n, &self.cd.q);
-        let h = if started { self.settings.dt } else { 0.0 };
-        fluid.apply::<K>(fe, n, (&self.cd.qd, &self.cd.qdd, h), &mut self.external);
-    }
-
     /// Step 3: penetrations, frames, velocities (predicted when `predicted`) and normal
     /// forces at time `t`. Returns whether every open contact's values can be accumulated
     /// ([`ContactState::accumulable`]: for an open contact, its penetration squared is at
@@ -100,33 +27,30 @@ impl Simulation<'_> {
     pub(super) fn detect<K: Lanes, O: ContactKinds>(&mut self, t: f64, predicted: bool) -> bool {
         // four contacts or more: their dot products together (with fewer, the pass over `q`
         // for all of them costs more than it saves)
-        if O::COMMON && self.normal_dots.len() >= 4 {
+        if O::COMMON && self.work.normal_dots.len() >= 4 {
             return self.detect_fixed::<K>();
         }
-        let velocity = if predicted {
-            &self.cd.qd_star
-        } else {
-            &self.cd.qd
-        };
-        let p = self.cd.q.len();
-        let penalty = O::penalty(matches!(self.tangential, Tangential::Penalty { .. }));
-        self.closed.clear();
+        let (w, x) = (&mut self.work, &self.state.modal);
+        let velocity = if predicted { &w.cd.qd_star } else { &x.qd };
+        let p = x.q.len();
+        let penalty = O::penalty(matches!(w.tangential, Tangential::Penalty { .. }));
+        w.closed.clear();
         let mut detected = Detected {
-            closed: &mut self.closed,
-            quarter_bound: 0.25 * self.accumulation_bound,
+            closed: &mut w.closed,
+            quarter_bound: 0.25 * w.accumulation_bound,
             open_within: true,
         };
-        for (k, (c, state)) in contact_states(self.model, &mut self.contacts) {
+        for (k, (c, state)) in contact_states(self.model, &mut self.state.contacts) {
             state.tangential_force = Vector2::zeros();
             state.held = false;
-            match O::rows(&self.frame_rows[k]) {
+            match O::rows(&w.frame_rows[k]) {
                 Some(rows) => {
-                    state.distance = rows.distance::<K>(&self.cd.q, O::is_fixed(c), &c.motion, t);
+                    state.distance = rows.distance::<K>(&x.q, O::is_fixed(c), &c.motion, t);
                     rows.update(state.distance, &mut state.frame);
                 }
                 None => {
                     let pt = &self.model.basis.points[c.point];
-                    state.x = pt.coords + recombine_with::<K>(&pt.rows, &self.cd.q);
+                    state.x = pt.coords + recombine_with::<K>(&pt.rows, &x.q);
                     state.frame = c.frame(&state.x, t);
                 }
             }
@@ -138,7 +62,7 @@ impl Simulation<'_> {
             if !O::is_fixed(c) {
                 state.frame.velocity = c.motion.at(t).1;
             }
-            match O::rows(&self.frame_rows[k]) {
+            match O::rows(&w.frame_rows[k]) {
                 Some(frame_rows) => {
                     state.set_velocity::<K>(
                         Kinematics::Rows(frame_rows, O::is_fixed(c)),
@@ -149,7 +73,7 @@ impl Simulation<'_> {
                 }
                 None => {
                     let rows = if c.at_surface() {
-                        let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
+                        let out = &mut w.surface_rows[3 * p * k..3 * p * (k + 1)];
                         c.surface_rows(pt, &state.frame.normal, out);
                         &*out
                     } else {
@@ -167,8 +91,8 @@ impl Simulation<'_> {
             if penalty {
                 // the anchor of the penalty law lives in the obstacle's frame
                 let (d, _) = c.motion.at(t);
-                let rows = contact_rows(self.model, &self.surface_rows, k);
-                state.x_relative = pt.coords + recombine_with::<K>(rows, &self.cd.q) - d;
+                let rows = contact_rows(self.model, &w.surface_rows, k);
+                state.x_relative = pt.coords + recombine_with::<K>(rows, &x.q) - d;
             }
         }
         detected.open_within
@@ -182,17 +106,19 @@ impl Simulation<'_> {
     /// law does not use it, and the Lagrange methods form `L q̇*` themselves.
     #[inline(always)]
     fn detect_fixed<K: Lanes>(&mut self) -> bool {
-        self.closed.clear();
+        let w = &mut self.work;
+        w.closed.clear();
         let mut detected = Detected {
-            closed: &mut self.closed,
-            quarter_bound: 0.25 * self.accumulation_bound,
+            closed: &mut w.closed,
+            quarter_bound: 0.25 * w.accumulation_bound,
             open_within: true,
         };
-        K::padded_dots(&self.normal_rows, &self.cd.q, &mut self.normal_dots);
+        K::padded_dots(&w.normal_rows, &self.state.modal.q, &mut w.normal_dots);
         let contacts = (self.model.contacts.iter())
-            .zip(&self.frame_rows)
-            .zip(&self.normal_dots);
-        for (k, (state, ((c, rows), &dot))) in self.contacts.iter_mut().zip(contacts).enumerate() {
+            .zip(&w.frame_rows)
+            .zip(&w.normal_dots);
+        let states = self.state.contacts.iter_mut();
+        for (k, (state, ((c, rows), &dot))) in states.zip(contacts).enumerate() {
             let rows = CommonContacts::rows(rows).expect("a common step's contact has rows");
             detected.contact(k, state, c, rows, dot);
         }
@@ -208,12 +134,12 @@ impl Simulation<'_> {
     #[inline(always)]
     pub(super) fn full_step_velocities<K: Lanes, O: ContactKinds>(&mut self, all: bool) {
         if all {
-            for k in 0..self.contacts.len() {
+            for k in 0..self.state.contacts.len() {
                 self.full_step_velocity::<K, O>(k);
             }
         } else {
-            for i in 0..self.closed.len() {
-                self.full_step_velocity::<K, O>(self.closed[i]);
+            for i in 0..self.work.closed.len() {
+                self.full_step_velocity::<K, O>(self.work.closed[i]);
             }
         }
     }
@@ -221,24 +147,25 @@ impl Simulation<'_> {
     /// [`Self::full_step_velocities`] of contact `k`.
     #[inline(always)]
     fn full_step_velocity<K: Lanes, O: ContactKinds>(&mut self, k: usize) {
-        let p = self.cd.q.len();
-        let (c, state) = (&self.model.contacts[k], &mut self.contacts[k]);
+        let (w, x) = (&mut self.work, &self.state.modal);
+        let p = x.q.len();
+        let (c, state) = (&self.model.contacts[k], &mut self.state.contacts[k]);
         if !O::is_fixed(c) {
-            state.frame.velocity = moving_full_step(&c.motion, self.step, self.settings.dt);
+            state.frame.velocity = moving_full_step(&c.motion, self.state.step, self.settings.dt);
         }
-        match O::rows(&self.frame_rows[k]) {
+        match O::rows(&w.frame_rows[k]) {
             Some(rows) => {
                 let kinematics = Kinematics::Rows(rows, O::is_fixed(c));
-                state.set_velocity::<K>(kinematics, O::damped(c), &self.cd.qd, true)
+                state.set_velocity::<K>(kinematics, O::damped(c), &x.qd, true)
             }
             None => {
                 let pt = &self.model.basis.points[c.point];
                 if c.at_surface() && !state.closed {
-                    let out = &mut self.surface_rows[3 * p * k..3 * p * (k + 1)];
+                    let out = &mut w.surface_rows[3 * p * k..3 * p * (k + 1)];
                     c.surface_rows(pt, &state.frame.normal, out);
                 }
-                let rows = contact_rows(self.model, &self.surface_rows, k);
-                state.set_velocity::<K>(Kinematics::Point(rows), O::damped(c), &self.cd.qd, true);
+                let rows = contact_rows(self.model, &w.surface_rows, k);
+                state.set_velocity::<K>(Kinematics::Point(rows), O::damped(c), &x.qd, true);
             }
         }
     }

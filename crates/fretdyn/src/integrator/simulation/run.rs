@@ -1,90 +1,17 @@
-//! A run as a whole: progress, termination, results, the in-memory driver ([`simulate`],
-//! [`run`]), divergence and the snapshot a checkpoint holds.
+//! A run as a whole, on [`drive`]: in memory ([`simulate`], [`run`]: every sample kept) or for
+//! its statistics only ([`statistics_run`] and its variants: the samples, impacts and blocks
+//! let go batch by batch, for studies and service lives).
 
 use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicBool, Ordering};
 
-use serde::Serialize;
-
-use super::{RunSettings, Simulation};
-use crate::accumulate::energy::EnergyBalance;
-use crate::accumulate::recorder::Recorder;
-use crate::accumulate::statistics::{BlockStatistics, ContactStatistics, Impact};
+use super::drive::{BatchEnd, BatchSink, Driven, drive};
+use super::results::{Progress, RunResults};
+use super::step::Simulation;
 use crate::accumulate::wear_map::WearMap;
-use crate::contact::tangential::SolverStatistics;
 use crate::error::Result;
 use crate::model::Model;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
-
-/// Progress report passed to the observer of [`run`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Progress {
-    /// Steps done.
-    pub step: u64,
-    /// Steps in the run.
-    pub total: u64,
-}
-
-/// How a run ended.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-#[serde(tag = "status", rename_all = "snake_case")]
-pub enum Termination {
-    /// Every step was done.
-    Completed,
-    /// The state became non-finite at `step`; results up to the previous sample are kept.
-    Diverged {
-        step: u64,
-        time: f64,
-        /// The contact whose force was non-finite first, if any.
-        contact: Option<String>,
-    },
-    /// The observer asked to stop.
-    Stopped { step: u64 },
-    /// Still running (statistics of a checkpoint).
-    InProgress { step: u64 },
-}
-
-/// Everything a run produces.
-#[derive(Debug, Clone)]
-pub struct RunResults {
-    /// Output time histories.
-    pub recorder: Recorder,
-    /// Per-contact statistics over every step of the window (THEORY §5).
-    pub contacts: Vec<ContactStatistics>,
-    /// Finished impacts of the window, in the order they ended (not drained by a streaming
-    /// driver).
-    pub impacts: Vec<Impact>,
-    /// Per-block statistics, block by block, contact by contact (when blocks are set).
-    pub blocks: Vec<BlockStatistics>,
-    /// Tangential solver counters.
-    pub solver: SolverStatistics,
-    /// Energy balance.
-    pub energy: EnergyBalance,
-    /// Steps done.
-    pub steps: u64,
-    /// Time step, s.
-    pub dt: f64,
-    /// Stability limit of the time step, s.
-    pub stable_dt: f64,
-    /// Wall-clock time of the step loop, s.
-    pub wall_time: f64,
-    /// How the run ended.
-    pub termination: Termination,
-    /// End time of the step at which the target relative error was met
-    /// (`[statistics] target_relative_error`), where the run stopped.
-    pub target_met_at: Option<f64>,
-}
-
-impl RunResults {
-    /// Steps per second of wall time.
-    pub fn steps_per_second(&self) -> f64 {
-        if self.wall_time > 0.0 {
-            self.steps as f64 / self.wall_time
-        } else {
-            0.0
-        }
-    }
-}
+use crate::settings::RunSettings;
 
 /// Runs `model` with `settings` without progress reporting.
 pub fn simulate(model: &Model, settings: &RunSettings) -> Result<RunResults> {
@@ -95,64 +22,51 @@ pub fn simulate(model: &Model, settings: &RunSettings) -> Result<RunResults> {
 /// stop the run by returning `ControlFlow::Break`.
 ///
 /// Errors are input errors (including a Δt above the stable limit). A run that diverges or is
-/// stopped returns `Ok` with its [`Termination`] and the results written so far.
+/// stopped returns `Ok` with its [`Termination`](super::Termination) and the results written
+/// so far.
 pub fn run(
     model: &Model,
     settings: &RunSettings,
     mut observer: impl FnMut(Progress) -> ControlFlow<()>,
 ) -> Result<RunResults> {
-    let mut sim = Simulation::new(model, settings)?;
-    // the time loop only, as a streamed run measures it
-    let start = Instant::now();
-    let total = settings.steps;
-    let mut termination = Termination::Completed;
-    while sim.steps_done() < total && sim.target_met().is_none() {
-        // to the end of the batch, where the observer is called
-        if let Err(d) = sim.steps(sim.steps_to_batch_end(total)) {
-            termination = d.into_termination(model);
-            break;
-        }
-        let n = sim.steps_done();
-        if n % Simulation::BATCH == 0
-            && n < total
-            && observer(Progress { step: n, total }).is_break()
-        {
-            termination = Termination::Stopped { step: n };
-            break;
-        }
-    }
-    let wall_time = start.elapsed().as_secs_f64();
+    let sim = Simulation::new(model, settings)?;
+    let Driven {
+        sim,
+        termination,
+        wall_time,
+    } = drive(sim, &mut InMemory(&mut observer))?;
     let _ = observer(Progress {
         step: sim.steps_done(),
-        total,
+        total: settings.steps,
     });
     Ok(sim.finish(wall_time, termination))
 }
 
-/// A step whose state became non-finite.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Divergence {
-    /// The step, counted from 1.
-    pub step: u64,
-    /// Its end time, s.
-    pub time: f64,
-    /// The contact whose force was non-finite first, if any.
-    pub contact: Option<usize>,
-}
+/// A run held in memory: its recorder has room for every sample, the observer hears of the
+/// progress.
+struct InMemory<F>(F);
 
-impl Divergence {
-    /// The [`Termination`] it causes.
-    pub fn into_termination(self, model: &Model) -> Termination {
-        Termination::Diverged {
-            step: self.step,
-            time: self.time,
-            contact: self.contact.map(|c| model.contacts[c].name.clone()),
-        }
+impl<F: FnMut(Progress) -> ControlFlow<()>> BatchSink for InMemory<F> {
+    fn drain(&mut self, _sim: &mut Simulation) -> Result<()> {
+        // full only after the last sample: every sample is kept
+        Ok(())
+    }
+
+    fn batch_end(&mut self, _sim: &mut Simulation, end: BatchEnd) -> Result<ControlFlow<()>> {
+        Ok(if end.before_the_end() {
+            (self.0)(Progress {
+                step: end.step,
+                total: end.total,
+            })
+        } else {
+            ControlFlow::Continue(())
+        })
     }
 }
 
-/// A run of `model` with `settings` for its statistics only ([`crate::apps::study::run_statistics`]); with `wear_bins`, also where each contact's
-/// wear work was done ([`WearMap`] with that many bins around a hole, THEORY §14.3).
+/// A run of `model` with `settings` for its statistics only ([`crate::apps::study`]); with
+/// `wear_bins`, also where each contact's wear work was done ([`WearMap`] with that many bins
+/// around a hole, THEORY §14.3).
 pub fn statistics_run(
     model: &Model,
     settings: &RunSettings,
@@ -162,7 +76,7 @@ pub fn statistics_run(
 }
 
 /// [`statistics_run`] that stops at the end of a batch of steps once `stop` is set
-/// ([`Termination::Stopped`]).
+/// ([`Termination::Stopped`](super::Termination::Stopped)).
 pub fn statistics_run_until(
     model: &Model,
     settings: &RunSettings,
@@ -173,48 +87,57 @@ pub fn statistics_run_until(
     if let Some(bins) = wear_bins {
         sim.track_wear(bins);
     }
-    statistics_run_from(sim, settings, &mut |sim| {
+    statistics_run_from(sim, &mut |_| {
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-            ControlFlow::Break(sim.steps_done())
+            ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
         }
     })
 }
 
-/// The loop of [`statistics_run`] from a simulation made (or resumed) by the caller:
-/// `at_batch(sim)` after every batch of steps before the last; `Break(step)` stops the run
-/// there ([`Termination::Stopped`]).
+/// [`statistics_run`] from a simulation made (or resumed) by the caller: `at_batch(sim)`
+/// after every batch of steps before the last; `Break` stops the run there
+/// ([`Termination::Stopped`](super::Termination::Stopped)). It runs to its last step even
+/// when the statistics meet their target.
 pub fn statistics_run_from(
-    mut sim: Simulation,
-    settings: &RunSettings,
-    at_batch: &mut dyn FnMut(&Simulation) -> ControlFlow<u64>,
+    sim: Simulation,
+    at_batch: &mut dyn FnMut(&Simulation) -> ControlFlow<()>,
 ) -> Result<(RunResults, Option<WearMap>)> {
-    let start = Instant::now();
-    let model = sim.model();
-    let total = settings.steps;
-    let mut termination = Termination::Completed;
-    while sim.steps_done() < total {
-        // to the end of the batch, where the finished impacts and blocks are let go
-        if let Err(d) = sim.steps(sim.steps_to_batch_end(total)) {
-            termination = d.into_termination(model);
-            break;
-        }
-        if sim.recorder().is_full() {
-            sim.recorder_mut().clear();
-        }
-        if sim.steps_done().is_multiple_of(Simulation::BATCH) {
-            let statistics = sim.statistics_mut();
-            statistics.impacts.clear();
-            statistics.blocks.clear();
-            if sim.steps_done() < total
-                && let ControlFlow::Break(step) = at_batch(&sim)
-            {
-                termination = Termination::Stopped { step };
-                break;
-            }
-        }
-    }
+    let Driven {
+        sim,
+        termination,
+        wall_time,
+    } = drive(sim, &mut StatisticsOnly(at_batch))?;
     let map = sim.wear_map().cloned();
-    Ok((sim.finish(start.elapsed().as_secs_f64(), termination), map))
+    Ok((sim.finish(wall_time, termination), map))
+}
+
+/// A run kept for its statistics: the samples, the finished impacts and the blocks are let
+/// go as they come.
+struct StatisticsOnly<'a>(&'a mut dyn FnMut(&Simulation) -> ControlFlow<()>);
+
+impl BatchSink for StatisticsOnly<'_> {
+    fn stops_at_target(&self) -> bool {
+        false
+    }
+
+    fn drain(&mut self, sim: &mut Simulation) -> Result<()> {
+        sim.recorder_mut().clear();
+        Ok(())
+    }
+
+    fn batch_end(&mut self, sim: &mut Simulation, end: BatchEnd) -> Result<ControlFlow<()>> {
+        if !end.whole {
+            return Ok(ControlFlow::Continue(()));
+        }
+        let statistics = sim.statistics_mut();
+        statistics.impacts.clear();
+        statistics.blocks.clear();
+        Ok(if end.before_the_end() {
+            (self.0)(sim)
+        } else {
+            ControlFlow::Continue(())
+        })
+    }
 }

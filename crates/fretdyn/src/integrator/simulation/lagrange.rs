@@ -1,17 +1,15 @@
-//! Phase 3 of a step — the Lagrange tangential solve: the Delassus problem on the closed
+//! Phase 4 of a step — the Lagrange tangential solve: the Delassus problem on the closed
 //! contacts, solved by projected Gauss–Seidel or Active Set, applied to the acceleration
 //! (THEORY §2 step 6, §4.2–§4.6).
 
 use nalgebra::Vector2;
 
-use super::{RunSettings, Simulation, contact_rows};
-use crate::contact::delassus::{Slot, TangentialProblem};
+use super::step::Simulation;
+use super::workspace::{LagrangeSolver, Tangential, contact_rows};
+use crate::contact::delassus::Slot;
 use crate::contact::friction::Slide;
-use crate::contact::tangential::active_set::{ActiveSet, History, Outcome};
-use crate::contact::tangential::penalty::PenaltyContact;
+use crate::contact::tangential::active_set::{History, Outcome};
 use crate::contact::tangential::{StickVelocity, gauss_seidel};
-use crate::integrator::central_difference::CentralDifference;
-use crate::model::Model;
 use crate::numerics::Lanes;
 
 impl Simulation<'_> {
@@ -24,17 +22,16 @@ impl Simulation<'_> {
             theta_dt,
             lambda,
             slide,
-            history,
-            previous_lambda,
             work,
-        } = &mut self.tangential
+        } = &mut self.work.tangential
         else {
             return;
         };
+        let (history, previous_lambda) = (&mut self.state.history, &mut self.state.previous_lambda);
         problem.clear();
-        for &k in &self.closed {
-            let (c, state) = (&self.model.contacts[k], &self.contacts[k]);
-            let cd = &self.cd;
+        for &k in &self.work.closed {
+            let (c, state) = (&self.model.contacts[k], &self.state.contacts[k]);
+            let cd = &self.work.cd;
             problem.push_with(
                 Slot {
                     contact: k,
@@ -42,7 +39,7 @@ impl Simulation<'_> {
                     s_dynamic: c.friction.mu_dynamic * state.normal_force,
                 },
                 &state.frame.tangents,
-                contact_rows(self.model, &self.surface_rows, k),
+                contact_rows(self.model, &self.work.surface_rows, k),
                 |l, out| cd.apply_a_inv(l, out),
             );
         }
@@ -50,10 +47,11 @@ impl Simulation<'_> {
             history.iter_mut().for_each(|h| h.closed = false);
             return;
         }
-        let (contacts, model, dt) = (&self.contacts, self.model, self.settings.dt);
+        let (contacts, model, dt) = (&self.state.contacts, self.model, self.settings.dt);
         let half_step = self.settings.stick_velocity == StickVelocity::HalfStep;
-        let step = self.step;
-        problem.assemble_with::<K>(&self.cd.qdd, &self.cd.qd_star, *theta_dt, |slot| {
+        let step = self.state.step;
+        let (qdd, qd_star) = (&self.state.modal.qdd, &self.work.cd.qd_star);
+        problem.assemble_with::<K>(qdd, qd_star, *theta_dt, |slot| {
             let f = &contacts[slot.contact].frame;
             let motion = &model.contacts[slot.contact].motion;
             // the half-step velocity moves the point from t_{n+1} to t_{n+2}: the obstacle's
@@ -84,35 +82,29 @@ impl Simulation<'_> {
             };
             // held: both half-step velocities of q̇_{n+1} imposed (only this step's with the
             // full-step constraint) — the previous step's part here, this step's stick below
-            self.contacts[slot.contact].held =
+            self.state.contacts[slot.contact].held =
                 !half_step || (before.closed && before.slide == Slide::Stick);
         }
-        self.solver_stats.lagrange_steps += 1;
+        let stats = &mut self.state.solver;
+        stats.lagrange_steps += 1;
         let mut residual = None;
         match solver {
             LagrangeSolver::GaussSeidel(s) => {
                 // Gauss–Seidel tolerates a singular H (the modal forces are unique, λ is
                 // not); it is counted all the same (THEORY §4.6).
                 if problem.is_singular(work) {
-                    self.solver_stats.singular_delassus += 1;
+                    stats.singular_delassus += 1;
                 }
                 let sweeps = gauss_seidel::solve(s, problem, &mut lambda[..m], &mut slide[..m]);
-                self.solver_stats.gs_sweeps_total += sweeps.count as u64;
-                self.solver_stats.gs_sweeps_max =
-                    self.solver_stats.gs_sweeps_max.max(sweeps.count as u64);
+                stats.gs_sweeps_total += sweeps.count as u64;
+                stats.gs_sweeps_max = stats.gs_sweeps_max.max(sweeps.count as u64);
                 if !sweeps.converged {
-                    self.solver_stats.gs_nonconverged_steps += 1;
+                    stats.gs_nonconverged_steps += 1;
                 }
                 residual = sweeps.residual;
             }
             LagrangeSolver::ActiveSet(a) => {
-                let outcome = a.solve(
-                    problem,
-                    history,
-                    &mut lambda[..m],
-                    &mut slide[..m],
-                    &mut self.solver_stats,
-                );
+                let outcome = a.solve(problem, history, &mut lambda[..m], &mut slide[..m], stats);
                 if matches!(outcome, Outcome::Converged(_)) {
                     residual = Some(a.residual(problem, &lambda[..m], &slide[..m]));
                 }
@@ -120,12 +112,12 @@ impl Simulation<'_> {
         }
         let residual =
             residual.unwrap_or_else(|| problem.natural_map_residual(&lambda[..m], &slide[..m]));
-        self.solver_stats.add_residual(residual);
-        problem.apply::<K>(&lambda[..m], &mut self.cd.qdd);
+        stats.add_residual(residual);
+        problem.apply::<K>(&lambda[..m], &mut self.state.modal.qdd);
         history.iter_mut().for_each(|h| h.closed = false);
         let active_set = matches!(solver, LagrangeSolver::ActiveSet(_));
         for (k, slot) in problem.slots().iter().enumerate() {
-            let state = &mut self.contacts[slot.contact];
+            let state = &mut self.state.contacts[slot.contact];
             state.tangential_force = -lambda[k];
             state.slide = slide[k];
             state.held &= slide[k] == Slide::Stick;
@@ -141,65 +133,6 @@ impl Simulation<'_> {
                 },
             };
             previous_lambda[slot.contact] = lambda[k];
-        }
-    }
-}
-
-/// Method-specific state (one per run, so the size difference of the variants is irrelevant).
-#[allow(clippy::large_enum_variant)]
-pub(super) enum Tangential {
-    Penalty {
-        settings: crate::contact::tangential::PenaltySettings,
-        contacts: Vec<PenaltyContact>,
-    },
-    Lagrange {
-        problem: TangentialProblem,
-        solver: LagrangeSolver,
-        theta_dt: f64,
-        lambda: Vec<Vector2<f64>>,
-        slide: Vec<Slide>,
-        /// Per contact: previous step's status, direction and λ (warm start).
-        history: Vec<History>,
-        previous_lambda: Vec<Vector2<f64>>,
-        /// Work space of the singularity check.
-        work: Vec<f64>,
-    },
-}
-
-pub(super) enum LagrangeSolver {
-    GaussSeidel(crate::contact::tangential::GaussSeidelSettings),
-    ActiveSet(Box<ActiveSet>),
-}
-
-impl Tangential {
-    pub(super) fn lagrange(
-        model: &Model,
-        cd: &CentralDifference,
-        settings: &RunSettings,
-        solver: LagrangeSolver,
-    ) -> Self {
-        let nc = model.contacts.len();
-        let mut problem = TangentialProblem::new(model.basis.modes(), nc);
-        for (k, c) in model.contacts.iter().enumerate() {
-            if let Some(t) = c.fixed_tangents() {
-                let point = &model.basis.points[c.point];
-                let mut rows = point.rows.clone();
-                if c.at_surface() {
-                    // a plane: the normal never changes
-                    c.surface_rows(point, &c.frame(&point.coords, 0.0).normal, &mut rows);
-                }
-                problem.fix_rows(k, &t, &rows, |l, out| cd.apply_a_inv(l, out));
-            }
-        }
-        Tangential::Lagrange {
-            problem,
-            solver,
-            theta_dt: settings.stick_velocity.theta() * settings.dt,
-            lambda: vec![Vector2::zeros(); nc],
-            slide: vec![Slide::Stick; nc],
-            history: vec![History::default(); nc],
-            previous_lambda: vec![Vector2::zeros(); nc],
-            work: vec![0.0; 4 * nc * nc + 8 * nc],
         }
     }
 }
