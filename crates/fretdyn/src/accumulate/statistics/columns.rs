@@ -8,7 +8,7 @@
 //! Derived from it: the batch-means list [`BATCHED_STATISTICS`] and [`StandardErrors::values`],
 //! the columns of `contacts.csv` and `contacts_columns.csv`
 //! ([`crate::output::contacts_table`]), the statistics of `study.csv` ([`STUDY_STATISTICS`]),
-//! the header and rows of `blocks.csv` ([`BLOCK_COLUMNS`]), the Python package's
+//! the header and rows of `blocks.csv` ([`block_columns`]), the Python package's
 //! `statistics_columns()` and block columns, and the CLI's plot labels. Adding a statistic:
 //! its field in [`ContactStatistics`] and how [`super::accumulator`] forms it, and its row
 //! here (a batched one also its `_se` field in [`StandardErrors`] and its batch mean in
