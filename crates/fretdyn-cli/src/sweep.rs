@@ -603,8 +603,9 @@ fn parameter_value(key: &str, value: &str) -> String {
     }
 }
 
-/// Readable name and unit of a statistic of the study table
-/// ([`fretdyn::apps::study::TABLE_STATISTICS`]); another: its key with spaces, no unit.
+/// Readable name and unit of a statistic of the study table: a per-contact statistic's from
+/// the table of statistics ([`fretdyn::accumulate::statistics::STATISTICS`]), a life
+/// column's from [`known_life_column`]; another: its key with spaces, no unit.
 fn statistic_name(statistic: &str) -> (String, &'static str) {
     match known_statistic(statistic) {
         Some((name, unit)) => (name.to_string(), unit),
@@ -613,17 +614,15 @@ fn statistic_name(statistic: &str) -> (String, &'static str) {
 }
 
 fn known_statistic(statistic: &str) -> Option<(&'static str, &'static str)> {
-    Some(match statistic {
-        "impacts_per_second" => ("impact rate", "1/s"),
-        "contact_time_fraction" => ("fraction of the time in contact", ""),
-        "stick_time_fraction" => ("fraction of the time sticking", ""),
-        "slip_time_fraction" => ("fraction of the time slipping", ""),
-        "normal_force_mean" => ("mean normal force", "N"),
-        "normal_force_rms" => ("RMS normal force", "N"),
-        "normal_force_max" => ("maximum normal force", "N"),
-        "tangential_force_rms" => ("RMS tangential force", "N"),
-        "wear_work_rate" => ("wear work rate", "W"),
-        "normal_wear_work_rate" => ("wear work rate, R_N|v_T| definition", "W"),
+    fretdyn::accumulate::statistics::statistic(statistic)
+        .map(|s| (s.long_name, s.label_unit()))
+        .or_else(|| known_life_column(statistic))
+}
+
+/// Readable name and unit of a life column of the study table
+/// ([`fretdyn::apps::study::LIFE_COLUMNS`]).
+fn known_life_column(column: &str) -> Option<(&'static str, &'static str)> {
+    Some(match column {
         "depth_at_target" => ("tube depth at the target time", "m"),
         "depth_at_target_fixed_gap" => ("tube depth at the target time, fixed gap", "m"),
         "time_to_criterion" => ("time to the plugging criterion", "years"),
@@ -692,9 +691,14 @@ mod tests {
                 "{s}"
             );
         }
-        // every statistic of the table has a readable name
+        // every statistic of the table has a readable name, and a unit but for a fraction
         for s in fretdyn::apps::study::TABLE_STATISTICS {
             assert!(known_statistic(s).is_some(), "{s}");
         }
+        assert_eq!(statistic_label("impacts_per_second"), "impact rate (1/s)");
+        assert_eq!(
+            statistic_label("contact_time_fraction"),
+            "fraction of the time in contact"
+        );
     }
 }

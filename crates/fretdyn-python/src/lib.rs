@@ -487,7 +487,7 @@ fn blocks<'py>(
     blocks: &[fretdyn::accumulate::statistics::BlockStatistics],
     names: &[String],
 ) -> PyResult<Bound<'py, PyDict>> {
-    use fretdyn::accumulate::statistics::ContactStatistics;
+    use fretdyn::accumulate::statistics::{Kind, Value, block_columns};
     let out = PyDict::new(py);
     let block: Vec<i64> = blocks.iter().map(|b| b.block as i64).collect();
     out.set_item("block", PyArray1::from_vec(py, block))?;
@@ -508,27 +508,49 @@ fn blocks<'py>(
         })
         .collect();
     out.set_item("name", name)?;
-    let impacts: Vec<i64> = blocks.iter().map(|b| b.statistics.impacts as i64).collect();
-    out.set_item("impacts", PyArray1::from_vec(py, impacts))?;
-    type Column = fn(&ContactStatistics) -> f64;
-    let columns: [(&str, Column); 11] = [
-        ("impacts_per_second", |s| s.impacts_per_second),
-        ("contact_time_fraction", |s| s.contact_time_fraction),
-        ("stick_time_fraction", |s| s.stick_time_fraction),
-        ("slip_time_fraction", |s| s.slip_time_fraction),
-        ("normal_force_mean", |s| s.normal_force_mean),
-        ("normal_force_rms", |s| s.normal_force_rms),
-        ("normal_force_max", |s| s.normal_force_max),
-        ("tangential_force_rms", |s| s.tangential_force_rms),
-        ("wear_work_rate", |s| s.wear_work_rate),
-        ("normal_wear_work_rate", |s| s.normal_wear_work_rate),
-        ("wear_volume", |s| s.wear_volume),
-    ];
-    for (key, value) in columns {
-        out.set_item(
-            key,
-            PyArray1::from_vec(py, blocks.iter().map(|b| value(&b.statistics)).collect()),
-        )?;
+    for column in block_columns() {
+        let values = blocks.iter().map(|b| (column.value)(&b.statistics));
+        match column.kind {
+            Kind::Count => {
+                let counts = values
+                    .map(|v| match v {
+                        Value::Count(n) => n as i64,
+                        Value::Real(x) => x as i64,
+                    })
+                    .collect();
+                out.set_item(column.key, PyArray1::from_vec(py, counts))?;
+            }
+            Kind::Real => {
+                let reals = values.map(Value::as_f64).collect();
+                out.set_item(column.key, PyArray1::from_vec(py, reals))?;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The one table of per-contact statistics (`fretdyn::accumulate::statistics::columns`,
+/// from which `summary.json`, `contacts.csv`, `study.csv` and `blocks.csv` are derived): a
+/// dict per statistic, in the order of `contacts.csv`, with `key`, `unit` (`1` for a number
+/// without one), `long_name`, `meaning`, `code_aster` (empty when Code_Aster has none),
+/// `count` (an integer), `se_key` (`<key>_se`, or None without a standard error by batch
+/// means), `study` and `blocks` (a column of `study.csv`, of `blocks.csv`).
+#[pyfunction]
+fn statistics_columns(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    use fretdyn::accumulate::statistics::{Kind, STATISTICS};
+    let out = PyList::empty(py);
+    for s in STATISTICS {
+        let d = PyDict::new(py);
+        d.set_item("key", s.key)?;
+        d.set_item("unit", s.unit)?;
+        d.set_item("long_name", s.long_name)?;
+        d.set_item("meaning", s.meaning)?;
+        d.set_item("code_aster", s.code_aster)?;
+        d.set_item("count", s.kind == Kind::Count)?;
+        d.set_item("se_key", s.batched.map(|b| b.se_key))?;
+        d.set_item("study", s.study)?;
+        d.set_item("blocks", s.blocks)?;
+        out.append(d)?;
     }
     Ok(out)
 }
@@ -819,6 +841,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(case_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(case_with, m)?)?;
     m.add_function(wrap_pyfunction!(variables, m)?)?;
+    m.add_function(wrap_pyfunction!(statistics_columns, m)?)?;
     m.add_function(wrap_pyfunction!(coordinates, m)?)?;
     m.add("RESULTS_COMMENT", fretdyn::output::variables::COMMENT)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;

@@ -3,6 +3,7 @@ impacts, blocks, contacts, `to_xarray`), `Case.with_`/`to_dict` against the same
 in the TOML text, studies given as dicts against the same study file, and the API page in
 the docs against the docstrings."""
 
+import csv
 import importlib.util
 import json
 import os
@@ -56,6 +57,27 @@ def test_a_result_has_the_arrays_as_attributes_and_as_items(tube_run):
     assert r.contact_names == [c["name"] for c in summary["contacts"]]
     assert r.contact_names == r.case.contact_names
     assert "5 contacts" in repr(r) and "completed" in repr(r)
+
+
+def test_the_statistics_columns_are_the_tables_columns(tube_run):
+    # one table of statistics: the files' columns and the summary's keys are its keys
+    out, r = tube_run
+    table = fretdyn.statistics_columns()
+    keys = [s["key"] for s in table]
+    assert keys[:3] == ["duration", "impacts", "impacts_per_second"]
+    assert {s["key"]: s["unit"] for s in table}["wear_work_rate"] == "W"
+    with open(out / "contacts.csv", newline="") as f:
+        header = next(csv.reader(f))
+    assert header[2:2 + len(keys)] == keys
+    errors = [s["se_key"] for s in table if s["se_key"]]
+    assert errors and all(e in header for e in errors)
+    assert all(s["se_key"] in (None, s["key"] + "_se") for s in table)
+    with open(out / "blocks.csv", newline="") as f:
+        blocks = next(csv.reader(f))
+    assert blocks[4:] == [s["key"] for s in table if s["blocks"]]
+    assert [s["key"] for s in table if s["count"]] == ["impacts"]
+    for contact in r.summary["contacts"]:
+        assert set(keys) <= set(contact)
 
 
 def test_impacts_and_blocks_are_the_cli_tables(tube_run):

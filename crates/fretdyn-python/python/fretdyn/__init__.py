@@ -42,8 +42,8 @@ from . import med  # modal bases from Code_Aster's MED files (docs/MED.md)
 
 __all__ = [
     "Case", "Result", "FretdynError", "run", "stability", "sweep", "percentiles",
-    "read_table", "modal_structure", "variables", "life", "modes", "LifeResult",
-    "ModesResult", "plot", "__version__",
+    "read_table", "modal_structure", "variables", "statistics_columns", "life", "modes",
+    "LifeResult", "ModesResult", "plot", "__version__",
 ]
 __version__ = _native.__version__
 
@@ -217,6 +217,34 @@ def variables(modal: bool = True) -> Tuple[List[dict], List[dict]]:
     'm s-1'
     """
     return _native.variables(modal)
+
+
+def statistics_columns() -> List[dict]:
+    """The per-contact statistics of a run, with their units and names.
+
+    One table in the Rust library (``fretdyn::accumulate::statistics::columns``) holds them:
+    ``summary["contacts"]``, ``contacts.csv`` (and `Result.contacts`), the statistics of a
+    study's table (``<contact>.<key>``) and ``blocks.csv`` (`Result.blocks`) are derived from
+    it.
+
+    Returns
+    -------
+    list of dict
+        One dict per statistic, in the order of the columns of ``contacts.csv``, with the keys
+        ``key`` (e.g. ``wear_work_rate``), ``unit`` (SI; ``1`` for a number without one),
+        ``long_name`` (a short readable name, for labels), ``meaning``, ``code_aster`` (its
+        name in Code_Aster's ``POST_DYNA_MODA_T``; empty when Code_Aster has none),
+        ``count`` (True for an integer), ``se_key`` (the key of its standard error by batch
+        means, ``<key>_se``, or None), ``study`` and ``blocks`` (whether a study's table and
+        ``blocks.csv`` have it).
+
+    Examples
+    --------
+    >>> units = {s["key"]: s["unit"] for s in fretdyn.statistics_columns()}
+    >>> units["wear_work_rate"]
+    'W'
+    """
+    return _native.statistics_columns()
 
 
 def _units() -> dict:

@@ -269,10 +269,9 @@ def forces(result: Any, contact: Contacts = None, ax: Any = None):
     return _returned(axes)
 
 
-_WEAR = {
-    "wear_work_rate": "wear work rate, friction power",
-    "normal_wear_work_rate": "normal wear work rate, mean of R_N |v_T|",
-}
+# the statistics `wear` draws; their names and standard errors are the table's
+# (fretdyn.statistics_columns)
+_WEAR = ("wear_work_rate", "normal_wear_work_rate")
 
 
 def wear(result: Any, statistic: str = "wear_work_rate", ax: Any = None):
@@ -302,11 +301,15 @@ def wear(result: Any, statistic: str = "wear_work_rate", ax: Any = None):
     """
     if statistic not in _WEAR:
         raise ValueError(f"statistic must be one of {list(_WEAR)}, not {statistic!r}")
+    from . import _native
+
+    column = next(c for c in _native.statistics_columns() if c["key"] == statistic)
+    se = column["se_key"]
     ax = _axes(ax)
     contacts = result.summary["contacts"]
     names = [c["name"] for c in contacts]
     heights = np.array([c[statistic] for c in contacts], dtype=float) * _MW
-    errors = np.array([np.nan if c.get(f"{statistic}_se") is None else c[f"{statistic}_se"]
+    errors = np.array([np.nan if c.get(se) is None else c[se]
                        for c in contacts], dtype=float) * _MW
     x = np.arange(len(names))
     ax.bar(x, heights, yerr=None if np.all(np.isnan(errors)) else np.nan_to_num(errors),
@@ -314,7 +317,7 @@ def wear(result: Any, statistic: str = "wear_work_rate", ax: Any = None):
     ax.set_xticks(x)
     ax.set_xticklabels(names)
     ax.set_xlabel("contact")
-    ax.set_ylabel(f"{_WEAR[statistic]} (mW)")
+    ax.set_ylabel(f"{column['long_name']} (m{column['unit']})")
     _title(ax, f"{result.case.title}: wear work rate ± standard error")
     return ax
 

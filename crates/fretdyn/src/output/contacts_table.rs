@@ -7,17 +7,20 @@
 //! so that every cell is the summary's value: a number at full precision (the shortest text
 //! that reads back to the same `f64`), a count as an integer, `true`/`false`, and an empty cell
 //! where the summary has `null` or no such key (a standard error with fewer than 2 batches,
-//! the volume rates of a contact without `wear`). The columns are [`COLUMNS`], always all of
-//! them and in that order, so that the tables of several runs stack; a key that the summary
-//! gains and [`COLUMNS`] does not know yet follows them (nested objects flattened with dotted
+//! the volume rates of a contact without `wear`). The columns are [`columns`] (derived from the
+//! table of statistics, [`crate::accumulate::statistics::columns`]), always all of them and in
+//! that order, so that the tables of several runs stack; a key that the summary gains and
+//! [`columns`] does not know yet follows them (nested objects flattened with dotted
 //! names). Lists ([`LEFT_OUT`]: the peak-force histogram, whose bins differ per contact) stay
 //! in `summary.json` only. Written with the `csv` crate: a name with a comma, a quote or a
 //! line break is quoted.
 
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 use serde_json::{Map, Value};
 
+use crate::accumulate::statistics::{STATISTICS, batched_statistics};
 use crate::error::Result;
 use crate::files::write_atomically;
 
@@ -27,7 +30,7 @@ pub const CONTACTS_FILE: &str = "contacts.csv";
 pub const COLUMNS_FILE: &str = "contacts_columns.csv";
 
 /// A column of `contacts.csv`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Column {
     /// fretdyn's key: the header, and the key of `summary.json`'s `contacts[k]`.
     pub key: &'static str,
@@ -39,7 +42,7 @@ pub struct Column {
     /// docs/CODE_ASTER.md says where the definitions differ.
     pub code_aster: &'static str,
     /// What it is.
-    pub meaning: &'static str,
+    pub meaning: Cow<'static, str>,
 }
 
 const fn column(
@@ -52,14 +55,12 @@ const fn column(
         key,
         unit,
         code_aster,
-        meaning,
+        meaning: Cow::Borrowed(meaning),
     }
 }
 
-/// The columns of `contacts.csv`, in order: the contact's index and name, then the fields of
-/// [`crate::accumulate::statistics::ContactStatistics`], the wear volume rates of a contact with
-/// `wear`, and the standard errors by batch means with their batches (THEORY §5).
-pub const COLUMNS: &[Column] = &[
+/// The columns before the statistics: the contact's index and name.
+const CONTACT_COLUMNS: [Column; 2] = [
     column(
         "contact",
         "1",
@@ -67,175 +68,11 @@ pub const COLUMNS: &[Column] = &[
         "index of the contact in the case file (0 is the first [[contacts]]), as in impacts.csv",
     ),
     column("name", "", "INTITULE", "contact name"),
-    column(
-        "duration",
-        "s",
-        "INST_FIN - INST_INIT",
-        "duration of the statistics window [t_start, t_end]",
-    ),
-    column(
-        "impacts",
-        "1",
-        "number of CALCUL='IMPACT' rows (OPTION='IMPACT')",
-        "impacts started in the window (an opening longer than rest_duration ends an impact)",
-    ),
-    column(
-        "impacts_per_second",
-        "1/s",
-        "NB_CHOC_S (STAT_CHOC)",
-        "impacts per second",
-    ),
-    column(
-        "rebounds_per_impact",
-        "1",
-        "NB_REBON_CHOC - 1 (STAT_CHOC)",
-        "mean number of rebounds (openings shorter than rest_duration) per finished impact",
-    ),
-    column(
-        "contact_duration_mean",
-        "s",
-        "T_CHOC_MOYEN (STAT_CHOC)",
-        "mean duration of the finished impacts, first closing to last opening",
-    ),
-    column(
-        "contact_duration_min",
-        "s",
-        "T_CHOC_MINI (STAT_CHOC)",
-        "shortest finished impact",
-    ),
-    column(
-        "contact_duration_max",
-        "s",
-        "T_CHOC_MAXI (STAT_CHOC)",
-        "longest finished impact",
-    ),
-    column(
-        "contact_time_fraction",
-        "1",
-        "%_T_CHOC / 100 (STAT_CHOC)",
-        "fraction of the window spent closed",
-    ),
-    column(
-        "stick_time_fraction",
-        "1",
-        "",
-        "fraction of the window spent closed and sticking",
-    ),
-    column(
-        "slip_time_fraction",
-        "1",
-        "",
-        "fraction of the window spent closed and sliding",
-    ),
-    column(
-        "normal_force_mean",
-        "N",
-        "MOYEN_T_TOTAL (FORCE_NORMALE)",
-        "mean normal force R_N over the whole window",
-    ),
-    column(
-        "normal_force_mean_in_contact",
-        "N",
-        "MOYEN_T_CHOC (FORCE_NORMALE)",
-        "mean normal force over the time spent closed",
-    ),
-    column(
-        "normal_force_rms",
-        "N",
-        "RMS_T_TOTAL (FORCE_NORMALE)",
-        "RMS normal force over the whole window",
-    ),
-    column(
-        "normal_force_max",
-        "N",
-        "MAXI (FORCE_NORMALE); F_MAX_ABS (GLOBAL)",
-        "largest normal force",
-    ),
-    column(
-        "tangential_force_mean",
-        "N",
-        "",
-        "mean tangential force magnitude |R_T| over the whole window",
-    ),
-    column(
-        "tangential_force_mean_in_contact",
-        "N",
-        "",
-        "mean |R_T| over the time spent closed",
-    ),
-    column(
-        "tangential_force_rms",
-        "N",
-        "sqrt(RMS (FORCE_TANG_1)^2 + RMS (FORCE_TANG_2)^2)",
-        "RMS of |R_T| over the whole window",
-    ),
-    column("tangential_force_max", "N", "", "largest |R_T|"),
-    column(
-        "wear_work",
-        "J",
-        "",
-        "friction work over the window, integral of |R_T . v_T| dt",
-    ),
-    column(
-        "wear_work_rate",
-        "W",
-        "",
-        "wear work rate as friction power, (1/T) integral of |R_T . v_T| dt (THEORY §5)",
-    ),
-    column(
-        "normal_wear_work_rate",
-        "W",
-        "PUIS_USURE (PUIS_USURE)",
-        "wear work rate with the normal force, (1/T) integral of R_N |v_T| dt (Code_Aster's definition)",
-    ),
-    column(
-        "wear_volume",
-        "m3",
-        "",
-        "Archard wear volume K_wear integral of |R_T . v_T| dt (0 without statistics.wear_coefficient)",
-    ),
-    column(
-        "penetration_max",
-        "m",
-        "",
-        "largest penetration (negative: the contact never closed; minus the smallest clearance)",
-    ),
-    column(
-        "displacement_mean",
-        "m",
-        "MOYEN (DEPL_RADIAL) in a hole; MOYEN (DEPL_Y or DEPL_Z) between bars",
-        "mean radial offset from the hole's centre (holes), or distance to the plane / the bars' mid-plane (planes)",
-    ),
-    column(
-        "displacement_rms",
-        "m",
-        "RMS (DEPL_RADIAL) in a hole; RMS (DEPL_Y or DEPL_Z) between bars",
-        "RMS of that displacement",
-    ),
-    column(
-        "displacement_min",
-        "m",
-        "MINI (DEPL_RADIAL) in a hole; MINI (DEPL_Y or DEPL_Z) between bars",
-        "smallest value of that displacement",
-    ),
-    column(
-        "displacement_max",
-        "m",
-        "MAXI (DEPL_RADIAL) in a hole; MAXI (DEPL_Y or DEPL_Z) between bars",
-        "largest value of that displacement",
-    ),
-    column(
-        "contact_angle_mean_deg",
-        "deg",
-        "close to MOYEN (DEPL_ANGULAIRE)",
-        "circular mean of the contact angle in the hole's plane over the time spent closed",
-    ),
-    column(
-        "contact_angle_spread_deg",
-        "deg",
-        "close to ECART_TYPE (DEPL_ANGULAIRE)",
-        "circular standard deviation of that angle",
-    ),
+];
+
+/// The columns after the statistics: the wear volume rates of a contact with `wear`
+/// ([`crate::output::summary`]).
+const WEAR_COLUMNS: [Column; 2] = [
     column(
         "tube_volume_rate",
         "m3/s",
@@ -248,66 +85,11 @@ pub const COLUMNS: &[Column] = &[
         "V_USUR_OBST / INST (POST_USURE)",
         "support wear volume rate by its wear law (contacts with wear)",
     ),
-    column(
-        "wear_work_rate_se",
-        "W",
-        "",
-        "standard error of wear_work_rate by batch means",
-    ),
-    column(
-        "normal_wear_work_rate_se",
-        "W",
-        "",
-        "standard error of normal_wear_work_rate",
-    ),
-    column(
-        "impacts_per_second_se",
-        "1/s",
-        "",
-        "standard error of impacts_per_second",
-    ),
-    column(
-        "contact_time_fraction_se",
-        "1",
-        "",
-        "standard error of contact_time_fraction",
-    ),
-    column(
-        "stick_time_fraction_se",
-        "1",
-        "",
-        "standard error of stick_time_fraction",
-    ),
-    column(
-        "slip_time_fraction_se",
-        "1",
-        "",
-        "standard error of slip_time_fraction",
-    ),
-    column(
-        "normal_force_mean_se",
-        "N",
-        "",
-        "standard error of normal_force_mean",
-    ),
-    column(
-        "normal_force_rms_se",
-        "N",
-        "",
-        "standard error of normal_force_rms",
-    ),
-    column(
-        "tangential_force_mean_se",
-        "N",
-        "",
-        "standard error of tangential_force_mean",
-    ),
-    column(
-        "tangential_force_rms_se",
-        "N",
-        "",
-        "standard error of tangential_force_rms",
-    ),
+];
+
+/// The last columns: the batches of the standard errors
+/// ([`crate::accumulate::statistics::StandardErrors`]).
+const BATCH_COLUMNS: [Column; 4] = [
     column(
         "batches",
         "1",
@@ -329,13 +111,45 @@ pub const COLUMNS: &[Column] = &[
     ),
 ];
 
+/// The columns of `contacts.csv`, in order: the contact's index and name, then the
+/// statistics of the table [`STATISTICS`] (the fields of
+/// [`crate::accumulate::statistics::ContactStatistics`]), the wear volume rates of a contact
+/// with `wear`, and the standard errors by batch means in the order of
+/// [`crate::accumulate::statistics::BATCHED_STATISTICS`] with their batches (THEORY §5).
+pub fn columns() -> Vec<Column> {
+    let statistics = STATISTICS.iter().map(|s| Column {
+        key: s.key,
+        unit: s.unit,
+        code_aster: s.code_aster,
+        meaning: Cow::Borrowed(s.meaning),
+    });
+    let errors = batched_statistics().map(|(s, b)| Column {
+        key: b.se_key,
+        unit: s.unit,
+        code_aster: "",
+        // the first says how
+        meaning: Cow::Owned(format!(
+            "standard error of {}{}",
+            s.key,
+            if b.index == 0 { " by batch means" } else { "" }
+        )),
+    });
+    CONTACT_COLUMNS
+        .into_iter()
+        .chain(statistics)
+        .chain(WEAR_COLUMNS)
+        .chain(errors)
+        .chain(BATCH_COLUMNS)
+        .collect()
+}
+
 /// Keys of `summary.json`'s `contacts[k]` that are lists, not one value per contact: they stay
 /// in `summary.json` only (the histogram's bins differ from contact to contact; its impacts are
 /// the rows of `impacts.csv`, with their `peak_force`).
 pub const LEFT_OUT: &[&str] = &["peak_force_histogram"];
 
 /// The header and the rows of `contacts.csv` from a summary (as [`super::output::summary`]
-/// makes it): [`COLUMNS`], then any other key the summary's contacts have, sorted.
+/// makes it): [`columns`], then any other key the summary's contacts have, sorted.
 pub fn contacts_table(summary: &Value) -> (Vec<String>, Vec<Vec<String>>) {
     let contacts: Vec<Map<String, Value>> = summary["contacts"]
         .as_array()
@@ -351,7 +165,7 @@ pub fn contacts_table(summary: &Value) -> (Vec<String>, Vec<Vec<String>>) {
                 .collect()
         })
         .unwrap_or_default();
-    let mut header: Vec<String> = COLUMNS.iter().map(|c| c.key.to_string()).collect();
+    let mut header: Vec<String> = columns().iter().map(|c| c.key.to_string()).collect();
     let mut others: Vec<&String> = contacts
         .iter()
         .flat_map(|c| c.keys())
@@ -393,13 +207,14 @@ pub fn write_contacts_csv(dir: &Path, summary: &Value) -> Result<PathBuf> {
         let mut csv = csv::Writer::from_writer(std::io::BufWriter::new(file));
         csv.write_record(["column", "unit", "code_aster", "meaning"])
             .map_err(std::io::Error::other)?;
+        let columns = columns();
         for key in &header {
-            let c = COLUMNS.iter().find(|c| c.key == key);
+            let c = columns.iter().find(|c| c.key == key);
             csv.write_record([
                 key.as_str(),
                 c.map_or("", |c| c.unit),
                 c.map_or("", |c| c.code_aster),
-                c.map_or("", |c| c.meaning),
+                c.map_or("", |c| &c.meaning),
             ])
             .map_err(std::io::Error::other)?;
         }
@@ -441,5 +256,62 @@ fn cell(value: Option<&Value>) -> String {
         },
         Some(Value::String(s)) => s.clone(),
         Some(other) => other.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accumulate::statistics::{BATCHED_STATISTICS, ContactStatistics};
+
+    /// The columns are the table of statistics in its order, between the contact and the
+    /// wear volume rates, then a `<key>_se` per statistic with batch means in their order
+    /// (with its unit), then the batches; and a summary's contact has no scalar that is
+    /// not a column (a field of the statistics missing from the table would be one).
+    #[test]
+    fn the_columns_are_the_table_of_statistics() {
+        let columns = columns();
+        let keys: Vec<&str> = columns.iter().map(|c| c.key).collect();
+        let n = STATISTICS.len();
+        assert_eq!(keys[..2], ["contact", "name"]);
+        let statistics: Vec<&str> = STATISTICS.iter().map(|s| s.key).collect();
+        assert_eq!(keys[2..2 + n], statistics[..]);
+        assert_eq!(
+            keys[2 + n..4 + n],
+            ["tube_volume_rate", "support_volume_rate"]
+        );
+        let errors: Vec<String> = BATCHED_STATISTICS
+            .iter()
+            .map(|k| format!("{k}_se"))
+            .collect();
+        assert_eq!(keys[4 + n..4 + n + errors.len()], errors[..]);
+        for (s, b) in batched_statistics() {
+            let c = columns.iter().find(|c| c.key == b.se_key).unwrap();
+            assert_eq!(c.unit, s.unit, "{}", b.se_key);
+            assert!(c.meaning.contains(s.key));
+        }
+        assert_eq!(
+            keys[4 + n + errors.len()..],
+            [
+                "batches",
+                "batch_length",
+                "batch_autocorrelation",
+                "batches_correlated"
+            ]
+        );
+        let mut contact: serde_json::Value = serde_json::json!({
+            "name": "a", "peak_force_histogram": [], "batches": 3, "batch_length": 0.5,
+            "batches_correlated": false, "batch_autocorrelation": 0.1,
+        });
+        for s in STATISTICS {
+            contact[s.key] = serde_json::json!(1);
+            if let Some(b) = s.batched {
+                contact[b.se_key] = serde_json::json!(0.5);
+            }
+        }
+        let statistics: ContactStatistics = serde_json::from_value(contact).unwrap();
+        let (header, rows) = contacts_table(&serde_json::json!({ "contacts": [statistics] }));
+        assert_eq!(header, keys, "no column but the table's");
+        assert_eq!(rows[0][2 + n], "", "no wear: an empty cell");
     }
 }

@@ -35,7 +35,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::accumulate::recorder::Recorder;
-use crate::accumulate::statistics::{BlockStatistics, Impact};
+use crate::accumulate::statistics::{BlockStatistics, Impact, block_columns};
 use crate::error::{Error, Result};
 use crate::integrator::simulation::{
     BatchEnd, BatchSink, Driven, Progress, RunResults, RunSettings, Simulation, Termination, drive,
@@ -325,7 +325,7 @@ impl Files {
             .write_all(IMPACTS_HEADER.as_bytes())
             .map_err(io(&dir.join(IMPACTS_FILE)))?;
         blocks
-            .write_all(BLOCKS_HEADER.as_bytes())
+            .write_all(blocks_header().as_bytes())
             .map_err(io(&dir.join(BLOCKS_FILE)))?;
         let mut files = Self {
             dir: dir.to_path_buf(),
@@ -440,26 +440,18 @@ impl Files {
         let path = self.dir.join(BLOCKS_FILE);
         for b in blocks {
             let s = &b.statistics;
-            writeln!(
-                self.blocks,
-                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            let w = &mut self.blocks;
+            let name = self.model_contacts.get(b.contact).map_or(&s.name, |n| n);
+            write!(
+                w,
+                "{},{},{},{}",
                 b.block,
                 b.t_start,
                 b.t_end,
-                csv_name(self.model_contacts.get(b.contact).map_or(&s.name, |n| n)),
-                s.impacts,
-                s.impacts_per_second,
-                s.contact_time_fraction,
-                s.stick_time_fraction,
-                s.slip_time_fraction,
-                s.normal_force_mean,
-                s.normal_force_rms,
-                s.normal_force_max,
-                s.tangential_force_rms,
-                s.wear_work_rate,
-                s.normal_wear_work_rate,
-                s.wear_volume
+                csv_name(name)
             )
+            .and_then(|()| block_columns().try_for_each(|c| write!(w, ",{}", (c.value)(s))))
+            .and_then(|()| writeln!(w))
             .map_err(|e| Error::io(&path, e))?;
         }
         Ok(())
@@ -544,7 +536,17 @@ fn reuse<T>(mut v: Vec<T>) -> Vec<T> {
 }
 
 const IMPACTS_HEADER: &str = "contact,name,start,duration,contact_time,peak_time,peak_force,impulse,impact_speed,rebound_speed,rebounds,angle_deg\n";
-const BLOCKS_HEADER: &str = "block,t_start,t_end,name,impacts,impacts_per_second,contact_time_fraction,stick_time_fraction,slip_time_fraction,normal_force_mean,normal_force_rms,normal_force_max,tangential_force_rms,wear_work_rate,normal_wear_work_rate,wear_volume\n";
+/// The header of `blocks.csv`: the block, its start and end, the contact's name, then the
+/// statistics of the table that `blocks.csv` has ([`block_columns`]).
+fn blocks_header() -> String {
+    let mut header = String::from("block,t_start,t_end,name");
+    for s in block_columns() {
+        header.push(',');
+        header.push_str(s.key);
+    }
+    header.push('\n');
+    header
+}
 
 /// A name safe in a CSV field.
 fn csv_name(name: &str) -> String {

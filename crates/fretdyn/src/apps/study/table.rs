@@ -8,19 +8,10 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::integrator::simulation::{RunResults, Termination};
 
-/// Statistics written per contact in the table, as `<contact>.<statistic>`.
-pub const TABLE_STATISTICS: [&str; 10] = [
-    "impacts_per_second",
-    "contact_time_fraction",
-    "stick_time_fraction",
-    "slip_time_fraction",
-    "normal_force_mean",
-    "normal_force_rms",
-    "normal_force_max",
-    "tangential_force_rms",
-    "wear_work_rate",
-    "normal_wear_work_rate",
-];
+/// Statistics written per contact in the table, as `<contact>.<statistic>`: those of the
+/// table of statistics marked for `study.csv`.
+pub const TABLE_STATISTICS: [&str; crate::accumulate::statistics::STUDY] =
+    crate::accumulate::statistics::STUDY_STATISTICS;
 
 /// The statistics of [`TABLE_STATISTICS`] with a standard error by batch means, written
 /// as `<contact>.<statistic>_se` after a contact's statistics (empty with fewer than 2
