@@ -14,7 +14,7 @@ use fretdyn::apps::benchmark::{methods, rattling_tube};
 use fretdyn::apps::verification::V1;
 use fretdyn::contact::friction::{DiagonalBlock, LocalSolve, local_solve_block};
 use fretdyn::contact::tangential::StickVelocity;
-use fretdyn::integrator::simulation::simulate;
+use fretdyn::simulate;
 use nalgebra::{Matrix2, Vector2};
 
 fn v1(c: &mut Criterion) {

@@ -1,10 +1,11 @@
 //! `fretdyn bench`: steps per second of V1 and of the synthetic rattling tube, per method.
 
+use fretdyn::Case;
 use fretdyn::apps::benchmark::{methods, rattling_tube};
 use fretdyn::apps::verification::V1;
-use fretdyn::case::Case;
 use fretdyn::contact::tangential::{StickVelocity, TangentialMethod};
-use fretdyn::integrator::simulation::{Termination, simulate};
+use fretdyn::integrator::simulation::Termination;
+use fretdyn::simulate;
 
 use std::path::Path;
 use std::time::Instant;
@@ -308,7 +309,7 @@ fn bench_case(case: &Case, repeat: usize) -> Result<(), Failure> {
     Ok(())
 }
 
-pub(crate) fn cpu_model() -> String {
+fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {

@@ -2,16 +2,16 @@
 //! with `wear` (THEORY §14.5, docs/WEAR.md) — windows of vibration, scar growth, the scars
 //! fed back into the obstacles, until the target time. Writes `life.csv` (one row per life
 //! step), `life.json` (the whole result), `scars.csv` (final scar profiles) and `life.png`.
-//! The library computes ([`fretdyn::apps::life::service_life`]); this prints and writes.
+//! The library computes ([`fretdyn::service_life`]); this prints and writes.
 
 use crate::run::significant;
 use std::path::{Path, PathBuf};
 
+use fretdyn::Case;
 use fretdyn::apps::life::{
     CHECKPOINT_FILE, LifeCheckpoint, LifeControl, LifeEnd, LifeResults, LifeStep, Unresumable,
     YEAR, convergence_csv, end_depths, service_life_with,
 };
-use fretdyn::case::Case;
 use fretdyn::error::number;
 
 use crate::Failure;
@@ -305,7 +305,7 @@ fn when(t: f64) -> String {
 /// command once the table is written. Ctrl-C or SIGTERM stops the refinements (no table).
 fn convergence(
     case: &Case,
-    life: &fretdyn::apps::life::LifeSettings,
+    life: &fretdyn::LifeSettings,
     first: &LifeResults,
     halvings: u32,
     dir: &Path,

@@ -4,7 +4,6 @@
 // the terminal: `<case name>` and `[flow]` there are words, not HTML or links.
 #![allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 
-mod against_c;
 mod bench;
 mod folder;
 mod life;
@@ -168,12 +167,10 @@ enum Command {
         /// The shell.
         shell: clap_complete::Shell,
     },
-    /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube (or, with
-    /// --against-c, side by side with a plain C implementation of the step).
+    /// Measure steps per second on V1 and on a synthetic 50-mode, 8-contact tube.
     Bench {
         /// Steps per run of the synthetic tube [default: 200000] (V1 runs its 4000 steps, 20 ×
-        /// repeat times). With --against-c: the steps of every timed run of both programs,
-        /// instead of 200000 on S1 and 50000 on the grid (for a quick check; not with --write).
+        /// repeat times).
         #[arg(long)]
         steps: Option<u64>,
         /// Repetitions; the best is reported.
@@ -187,32 +184,14 @@ enum Command {
         contacts: usize,
         /// Instead: the cost of a step over 10–200 modes × 1–50 contacts, per method, as a
         /// table, `scaling.csv` and `scaling.png` in this folder.
-        #[arg(long, value_name = "DIR", value_parser = path, conflicts_with = "against_c")]
-        scaling: Option<PathBuf>,
-        /// Instead: time fretdyn's step against the plain C one of DIR/step_ref.c (built with
-        /// gcc) on case S1 and on a grid of 10–200 modes × 1–50 contacts, after checking that
-        /// the two agree after 2000 steps; DIR is the perf folder, e.g. ../shared/perf. Takes
-        /// minutes; prints a markdown report.
         #[arg(long, value_name = "DIR", value_parser = path)]
-        against_c: Option<PathBuf>,
-        /// With --against-c: interleaved pairs (C, fretdyn) per timed case; medians are
-        /// reported. At least 5 with --write.
-        #[arg(long, default_value_t = 5, requires = "against_c")]
-        reps: usize,
-        /// With --against-c: only case S1 (seconds) or only the grid (minutes).
-        #[arg(long, value_enum, requires = "against_c")]
-        only: Option<against_c::Part>,
-        /// With --against-c: also put the report in this markdown file, between the lines
-        /// `<!-- against-c:begin -->` and `<!-- against-c:end -->` (appended with them when
-        /// they are absent).
-        #[arg(long, value_name = "FILE", value_parser = path, requires = "against_c")]
-        write: Option<PathBuf>,
+        scaling: Option<PathBuf>,
         /// Instead: time two case files against each other in this process, alternately
         /// (the order swapped every round), and report the median and quartiles of the
         /// per-round ratio of steps/s B/A — what resolves a few per cent on a shared machine
         /// (e.g. one friction method against another; --steps overrides both cases' steps).
         #[arg(long, num_args = 2, value_names = ["A", "B"], value_parser = path,
-              conflicts_with_all = ["against_c", "scaling"])]
+              conflicts_with = "scaling")]
         pair: Option<Vec<PathBuf>>,
         /// With --pair: rounds (each runs A and B once).
         #[arg(long, default_value_t = 100, requires = "pair")]
@@ -374,24 +353,13 @@ fn main() -> ExitCode {
             modes,
             contacts,
             scaling,
-            against_c,
-            reps,
-            only,
-            write,
             pair,
             rounds,
-        } => match (pair.as_deref(), scaling, against_c) {
+        } => match (pair.as_deref(), scaling) {
             // (clap takes exactly two values for --pair)
-            (Some([a, b]), _, _) => bench::pair(a, b, rounds, steps),
-            (_, _, Some(dir)) => against_c::main(&against_c::Options {
-                dir,
-                reps,
-                only,
-                steps,
-                write,
-            }),
-            (_, Some(dir), None) => bench::scaling(&dir, steps.unwrap_or(20_000).min(20_000)),
-            (_, None, None) => bench::main(steps.unwrap_or(200_000), repeat, modes, contacts),
+            (Some([a, b]), _) => bench::pair(a, b, rounds, steps),
+            (_, Some(dir)) => bench::scaling(&dir, steps.unwrap_or(20_000).min(20_000)),
+            (_, None) => bench::main(steps.unwrap_or(200_000), repeat, modes, contacts),
         },
     };
     match outcome {

@@ -10,10 +10,12 @@
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
+use fretdyn::Case;
+use fretdyn::RunResults;
 use fretdyn::apps::verification::V1;
-use fretdyn::case::Case;
-use fretdyn::integrator::simulation::{Progress, RunResults, Termination};
-use fretdyn::output::stream::{ResultsMetadata, StreamObserver, StreamSettings};
+use fretdyn::integrator::simulation::{Progress, Termination};
+use fretdyn::output::stream::ResultsMetadata;
+use fretdyn::{StreamObserver, StreamSettings};
 use ndarray::{Array3, Ix3};
 use ndarray_npy::NpzReader;
 use serde_json::json;
@@ -146,7 +148,7 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
         return Ok(());
     };
     let needed = series_bytes(case);
-    let size = fretdyn::accumulate::recorder::human_bytes;
+    let size = human_bytes;
     let verdict = disk_verdict(needed, needed, free);
     if verdict == DiskVerdict::SeriesShort {
         let raise = needed.div_ceil(free.max(1) / 2 + 1).max(2);
@@ -171,6 +173,28 @@ fn check_disk(case: &Case, path: &Path, dir: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
+/// `bytes` for a person: `1.5 GB` (powers of 1000, as the library's memory check says them).
+fn human_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 7] = ["bytes", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut value = bytes as f64;
+    let mut unit = 0;
+    while value >= 1000.0 && unit + 1 < UNITS.len() {
+        value /= 1000.0;
+        unit += 1;
+    }
+    match unit {
+        0 => format!("{bytes} bytes"),
+        _ => format!("{value:.1} {}", UNITS[unit]),
+    }
+}
+
+/// FNV-1a hash of bytes: the demo's fingerprint of a run (not a security measure).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf29ce484222325, |h, b| {
+        (h ^ *b as u64).wrapping_mul(0x100000001b3)
+    })
+}
+
 /// [`check_disk`] for a resumed run (a run stopped by a full disk is the usual one): refuses
 /// it when the time histories still to write do not fit (those already in `series/` stay), and
 /// warns, while some are still to write, when packing them at the end will not.
@@ -181,7 +205,7 @@ fn check_disk_to_resume(case: &Case, dir: &Path) -> Result<(), Failure> {
     let total = series_bytes(case);
     let written = folder_bytes(&dir.join(fretdyn::output::stream::SERIES_DIR));
     let remaining = total.saturating_sub(written);
-    let size = fretdyn::accumulate::recorder::human_bytes;
+    let size = human_bytes;
     match disk_verdict(remaining, total, free) {
         DiskVerdict::Fits => Ok(()),
         // every time history written: the packing starts at once, and says itself what
@@ -381,7 +405,7 @@ pub fn run_and_write(
         summary: None,
     };
     let results = if resume {
-        fretdyn::output::stream::resume(
+        fretdyn::resume(
             &case.model,
             &case.settings,
             dir,
@@ -390,7 +414,7 @@ pub fn run_and_write(
             &mut observer,
         )
     } else {
-        fretdyn::output::stream::run(
+        fretdyn::run(
             &case.model,
             &case.settings,
             dir,
@@ -620,7 +644,7 @@ fn demo(options: &Options) -> Result<(), Failure> {
         let slug = label.split_whitespace().next().unwrap_or("run").to_string();
         let case = v1.case(&format!("V1a {label}"), method);
         let sub = dir.join(&slug);
-        let fingerprint = fretdyn::output::stream::fnv1a(case.title.as_bytes());
+        let fingerprint = fnv1a(case.title.as_bytes());
         let _lock = crate::folder::lock(&sub, "run")?;
         run_and_write(&case, "demo", None, &sub, options, fingerprint, false)?;
         let (t, f) = read_friction(&sub)?;

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use fretdyn::case::Case;
+use fretdyn::Case;
 use fretdyn::loads::flow::StabilityReport;
 
 use crate::Failure;

@@ -7,8 +7,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
+use fretdyn::Study;
 use fretdyn::apps::percentiles::{PercentileReport, PercentileRow};
-use fretdyn::apps::study::{CONNORS_COLUMN, Study, StudyOptions, connors_exceedance};
+use fretdyn::apps::study::{CONNORS_COLUMN, StudyOptions, connors_exceedance};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Failure;

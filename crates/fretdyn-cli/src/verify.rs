@@ -5,7 +5,7 @@ use std::path::Path;
 
 use fretdyn::apps::verification::{Check, V1, V1Measurements, checks, measure, methods};
 use fretdyn::contact::tangential::{GaussSeidelSettings, StickVelocity, TangentialMethod};
-use fretdyn::integrator::simulation::{RunResults, simulate};
+use fretdyn::{RunResults, simulate};
 use serde_json::json;
 
 use crate::Failure;

@@ -9,37 +9,18 @@ use std::process::{Command, Stdio};
 use common::{Scratch, fretdyn};
 
 /// A mass pressed on a bar (10 N) sliding under it at 1 cm/s, μ = 0.3: `W = 0.03 W`.
-const CASE: &str = r#"
-title = "sliding mass"
-[time]
-dt = 1e-4
-duration = 1.5
-[structure]
-type = "modal"
-frequencies_hz = [5.0, 5.0, 0.0]
-damping_ratio = 0.7
-[[structure.points]]
-name = "mass"
-coords = [0.0, 0.0, 0.0]
-rows = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-[[loads]]
-point = "mass"
-force = [0.0, 0.0, -10.0]
-[[contacts]]
-name = "bar"
-point = "mass"
-obstacle = { type = "plane", origin = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], gap = 0.0, tangent = [1.0, 0.0, 0.0] }
-motion = { type = "velocity", velocity = [0.01, 0.0, 0.0] }
-normal = { stiffness = 1e6, damping = 2000.0 }
-friction = { mu = 0.3 }
-wear = { tube = { law = "archard", coefficient = 2e-15 }, support = { law = "archard", coefficient = 1e-15 }, scar = { type = "flat_bar", width = 0.02, tube_radius = 0.0095 } }
+const CASE: &str = concat!(
+    "\ntitle = \"sliding mass\"\n",
+    include_str!("../../fretdyn/tests/fixtures/sliding_mass.toml"),
+    r#"wear = { tube = { law = "archard", coefficient = 2e-15 }, support = { law = "archard", coefficient = 1e-15 }, scar = { type = "flat_bar", width = 0.02, tube_radius = 0.0095 } }
 [statistics]
 t_start = 1.0
 [life]
 target_years = 10.0
 max_depth_change = 0.2
 criterion_depth = 2e-4
-"#;
+"#
+);
 
 /// Circular segment of height `u` in a circle of radius `r`.
 fn segment(r: f64, u: f64) -> f64 {

@@ -31,7 +31,7 @@ fn err(e: fretdyn::Error) -> PyErr {
 /// A case: model and settings, ready to run, and the folder its file names are relative to.
 #[pyclass(module = "fretdyn._native", frozen)]
 struct Case {
-    inner: fretdyn::case::Case,
+    inner: fretdyn::Case,
     base_dir: PathBuf,
 }
 
@@ -145,7 +145,7 @@ impl Case {
 /// Reads a case file.
 #[pyfunction]
 fn load_case(path: PathBuf) -> PyResult<Case> {
-    fretdyn::case::Case::from_file(&path)
+    fretdyn::Case::from_file(&path)
         .map(|inner| Case {
             inner,
             base_dir: absolute(path.parent().unwrap_or(Path::new("."))),
@@ -157,7 +157,7 @@ fn load_case(path: PathBuf) -> PyResult<Case> {
 #[pyfunction]
 #[pyo3(signature = (text, base_dir = PathBuf::from(".")))]
 fn case_from_toml(text: &str, base_dir: PathBuf) -> PyResult<Case> {
-    fretdyn::case::Case::from_toml_str(text, &base_dir)
+    fretdyn::Case::from_toml_str(text, &base_dir)
         .map(|inner| Case {
             inner,
             base_dir: absolute(&base_dir),
@@ -211,7 +211,7 @@ fn case_from_map_at(
     base_dir: &Path,
 ) -> Result<Case, (Option<String>, String)> {
     let doc = Document::from_json(root).map_err(|e| (None, e))?;
-    fretdyn::case::Case::from_toml_str(&doc.text, base_dir)
+    fretdyn::Case::from_toml_str(&doc.text, base_dir)
         .map(|inner| Case {
             inner,
             base_dir: absolute(base_dir),
@@ -686,8 +686,8 @@ impl StudySource {
         }
     }
 
-    fn study(&self) -> PyResult<fretdyn::apps::study::Study> {
-        use fretdyn::apps::study::Study;
+    fn study(&self) -> PyResult<fretdyn::Study> {
+        use fretdyn::Study;
         match self {
             StudySource::File(path) => Study::from_file(path).map_err(|e| self.error(e)),
             StudySource::Dict(json, base_dir) => {

@@ -17,6 +17,7 @@ use fretdyn::integrator::simulation::simulate;
 /// V1a (THEORY §6) as a case file. The incoming velocity is written with Rust's shortest
 /// round-trip formatting of the same expressions `V1::model` evaluates, so it is exact.
 fn v1a_toml() -> String {
+    const POINT_MASS: &str = include_str!("fixtures/point_mass.toml");
     let v1 = V1::reference(20.0);
     let vx = v1.speed * v1.alpha.sin();
     let vz = -(v1.speed * v1.alpha.cos());
@@ -27,12 +28,7 @@ fn v1a_toml() -> String {
 dt = 1e-6
 duration = 4e-3
 
-[structure]
-type = "point_mass"
-mass = 1.0
-point = "mass"
-position = [0.0, 0.0, 0.0]
-
+{POINT_MASS}
 [initial]
 point = "mass"
 velocity = [{vx:?}, 0.0, {vz:?}]

@@ -1,7 +1,7 @@
 //! The phases of the step that visit the contacts are compiled twice: for any contact, and for
 //! the common case — every obstacle a fixed plane or fixed bars, an undamped normal law,
 //! friction by Lagrange multipliers — in which the other paths are not compiled
-//! ([`Simulation::runs_common_step`]). The two run the same operations in the same order: the
+//! ([`fretdyn::testing::runs_common_step`]). The two run the same operations in the same order: the
 //! results must be the same bit for bit, for every Lagrange method, with planes and with bars,
 //! with the AVX2 code and the portable one. The selection itself is checked: a case outside the
 //! common one runs the general code.
@@ -15,6 +15,7 @@ use fretdyn::contact::tangential::{
     ActiveSetSettings, GaussSeidelSettings, LocalSolve, PenaltySettings, TangentialMethod,
 };
 use fretdyn::integrator::simulation::{RunResults, Simulation, Termination};
+use fretdyn::testing;
 use nalgebra::Vector3;
 
 fn lagrange_methods() -> [TangentialMethod; 3] {
@@ -34,12 +35,12 @@ fn lagrange_methods() -> [TangentialMethod; 3] {
 fn run(case: &Case, general: bool, portable: bool) -> (RunResults, bool) {
     let mut sim = Simulation::new(&case.model, &case.settings).expect("valid case");
     if general {
-        sim.use_general_step();
+        testing::use_general_step(&mut sim);
     }
     if portable {
-        sim.use_portable_kernels();
+        testing::use_portable_kernels(&mut sim);
     }
-    let common = sim.runs_common_step();
+    let common = testing::runs_common_step(&sim);
     while sim.steps_done() < case.settings.steps {
         sim.step().expect("the run does not diverge");
     }
@@ -128,9 +129,9 @@ fn common_contacts_step_is_the_general_one() {
 fn cases_outside_the_common_one_run_the_general_code() {
     let gs = TangentialMethod::GaussSeidel(GaussSeidelSettings::default());
     let common = |case: &Case| {
-        Simulation::new(&case.model, &case.settings)
-            .expect("valid case")
-            .runs_common_step()
+        testing::runs_common_step(
+            &Simulation::new(&case.model, &case.settings).expect("valid case"),
+        )
     };
     assert!(common(&rattling_tube(10, 3, gs, 10)));
     assert!(common(&with_bars(rattling_tube(10, 3, gs, 10))));

@@ -11,20 +11,14 @@ use fretdyn::loads::TimeHistory;
 use fretdyn::loads::spatial_correlation::line_covariance;
 
 fn tube_case(extra: &str) -> String {
+    const SG_TUBE: &str = include_str!("fixtures/sg_tube.toml");
     format!(
         r#"
 [time]
 dt = 1e-5
 duration = 1e-3
 
-[structure]
-type = "tube"
-outer_diameter = 19.05e-3
-wall_thickness = 1.09e-3
-young_modulus = 2.0e11
-poisson_ratio = 0.3
-density = 8200.0
-path = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
+{SG_TUBE}path = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
 mesh_size = 0.05
 modes = 24
 

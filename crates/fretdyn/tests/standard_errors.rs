@@ -17,19 +17,15 @@ use fretdyn::case::Case;
 use fretdyn::integrator::simulation::{Termination, simulate};
 use fretdyn::output::stream::{self, ProgressOnly, StreamSettings};
 
-const CASE: &str = r#"
+const CASE: &str = concat!(
+    r#"
 title = "Tube tip rattling in a hole under white-noise turbulence"
 [time]
 dt = 1e-4
 duration = 10.5
-[structure]
-type = "tube"
-outer_diameter = 19.05e-3
-wall_thickness = 1.09e-3
-young_modulus = 2.0e11
-poisson_ratio = 0.3
-density = 8200.0
-path = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]
+"#,
+    include_str!("fixtures/sg_tube.toml"),
+    r#"path = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]
 mesh_size = 0.05
 modes = 4
 damping_ratio = DAMPING
@@ -60,7 +56,8 @@ EXTRA
 method = "gauss_seidel"
 [output]
 every = 1000
-"#;
+"#
+);
 
 fn case(seed: u64, damping: f64, extra: &str) -> Case {
     let text = CASE

@@ -17,20 +17,14 @@ use fretdyn::model::Model;
 /// A clamped–clamped 1 m tube of 10 elements (54 free DOFs, all kept), one mid-span contact
 /// on the tube surface (rotations enter its rows), a second one on the side, Rayleigh damping.
 fn case_text(modes: &str, fx: f64, r: f64) -> String {
+    const SG_TUBE: &str = include_str!("fixtures/sg_tube.toml");
     format!(
         r#"
 [time]
 dt = 2e-6
 duration = 0.02
 
-[structure]
-type = "tube"
-outer_diameter = 19.05e-3
-wall_thickness = 1.09e-3
-young_modulus = 2.0e11
-poisson_ratio = 0.3
-density = 8200.0
-inner_fluid_density = 1000.0
+{SG_TUBE}inner_fluid_density = 1000.0
 path = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]
 mesh_size = 0.1
 {modes}

@@ -14,7 +14,7 @@ fn avx2_and_portable_steps_give_the_same_bits() {
         let run = |portable: bool| {
             let mut sim = Simulation::new(&case.model, &case.settings).expect("valid case");
             if portable {
-                sim.use_portable_kernels();
+                fretdyn::testing::use_portable_kernels(&mut sim);
             }
             while sim.steps_done() < case.settings.steps {
                 sim.step().expect("the run does not diverge");

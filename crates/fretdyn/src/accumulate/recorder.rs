@@ -211,7 +211,7 @@ fn available_memory() -> Option<u64> {
 }
 
 /// `bytes` for a person: `1.5 GB` (powers of 1000).
-pub fn human_bytes(bytes: u64) -> String {
+pub(crate) fn human_bytes(bytes: u64) -> String {
     let units = ["bytes", "kB", "MB", "GB", "TB", "PB", "EB"];
     let mut value = bytes as f64;
     let mut unit = 0;

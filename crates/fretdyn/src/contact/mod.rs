@@ -2,7 +2,7 @@
 //! moving), the normal law and the friction coefficients. What leaves: per contact, the gap
 //! and frame ([`obstacle`]), the normal penalty force ([`NormalLaw`], THEORY §3) and the
 //! tangential force from a friction law ([`friction`]) or from the Lagrange problem on the
-//! Delassus operator ([`delassus`]) solved by the [`tangential`] methods (THEORY §4, §7, §8).
+//! Delassus operator (`delassus`, crate-private) solved by the [`tangential`] methods (THEORY §4, §7, §8).
 //!
 //! - [`obstacle`]: planes, bi-planes, circles, polygons: gap, normal, tangent frame;
 //! - [`scar`]: the clearance a wear scar adds to an obstacle (THEORY §14.4);
@@ -10,13 +10,21 @@
 //!   dot product);
 //! - [`motion`]: the imposed motion of an obstacle (THEORY §8);
 //! - [`friction`]: Coulomb coefficients, the local stick/slip solve;
-//! - [`delassus`]: the tangential problem `W λ + b` on the closed contacts (THEORY §4.2);
-//! - [`tangential`]: penalty, Active Set and projected Gauss–Seidel (THEORY §4.1, §4.3, §4.4).
+//! - `delassus` (crate-private): the tangential problem `W λ + b` on the closed contacts
+//!   (THEORY §4.2);
+//! - [`tangential`]: the settings of the penalty, Active Set and projected Gauss–Seidel
+//!   methods (THEORY §4.1, §4.3, §4.4; the solvers themselves are crate-private).
 //!
 //! A contact itself ([`Contact`]: structure point, obstacle, normal law, Coulomb
 //! coefficients) is defined here.
 
+// The Delassus problem is crate-private: public only for the crate's tests (feature `testing`).
+#[cfg(feature = "testing")]
 pub mod delassus;
+// (the builders and checks only the tests call are unused without it)
+#[cfg(not(feature = "testing"))]
+#[allow(dead_code)]
+pub(crate) mod delassus;
 pub mod frame_rows;
 pub mod friction;
 pub mod motion;

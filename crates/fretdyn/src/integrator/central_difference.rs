@@ -20,8 +20,8 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use crate::numerics::{Lanes, Portable};
 use crate::model::{Coordinates, Model};
+use crate::numerics::{Lanes, Portable};
 
 /// The linear operators of the coordinates.
 #[derive(Debug, Clone)]

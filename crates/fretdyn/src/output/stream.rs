@@ -288,7 +288,7 @@ fn fingerprint_with(fingerprint: u64, settings: &RunSettings) -> u64 {
 }
 
 /// FNV-1a hash of bytes (a fingerprint, not a security measure).
-pub fn fnv1a<'a>(bytes: impl IntoIterator<Item = &'a u8>) -> u64 {
+pub(crate) fn fnv1a<'a>(bytes: impl IntoIterator<Item = &'a u8>) -> u64 {
     bytes.into_iter().fold(0xcbf29ce484222325, |h, b| {
         (h ^ *b as u64).wrapping_mul(0x100000001b3)
     })

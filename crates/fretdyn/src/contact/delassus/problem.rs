@@ -339,7 +339,7 @@ impl TangentialProblem {
 
     /// Slot `k`'s Newton start within the step ([`crate::contact::friction::local_solve_block`]).
     #[inline]
-    pub fn newton_start(&self, k: usize) -> &Cell<f64> {
+    pub(crate) fn newton_start(&self, k: usize) -> &Cell<f64> {
         &self.newton[k]
     }
 

@@ -46,7 +46,7 @@ impl TangentialProblem {
     /// Records slot `k`'s local solve in a Gauss–Seidel sweep: its right-hand side `c_k`
     /// (the other contacts' λ as they were then) and the change of its `λ_k`.
     #[inline]
-    pub fn record_sweep(&self, k: usize, rhs: Vector2<f64>, change: Vector2<f64>) {
+    pub(crate) fn record_sweep(&self, k: usize, rhs: Vector2<f64>, change: Vector2<f64>) {
         self.sweep[k].set([rhs, change]);
     }
 

@@ -1,9 +1,19 @@
 //! The three tangential methods of THEORY §4: a penalty law (§4.1) and Lagrange multipliers
 //! solved by an Active Set method (§4.3) or a projected Gauss–Seidel (§4.4).
 
+// The solvers are crate-private: public only for the crate's tests (feature `testing`).
+#[cfg(feature = "testing")]
 pub mod active_set;
+#[cfg(not(feature = "testing"))]
+pub(crate) mod active_set;
+#[cfg(feature = "testing")]
 pub mod gauss_seidel;
+#[cfg(not(feature = "testing"))]
+pub(crate) mod gauss_seidel;
+#[cfg(feature = "testing")]
 pub mod penalty;
+#[cfg(not(feature = "testing"))]
+pub(crate) mod penalty;
 
 use serde::Serialize;
 
@@ -47,7 +57,7 @@ pub struct GaussSeidelSettings {
     /// Stop when `‖λ^{k+1} − λ^k‖ ≤ tol ‖λ^{k+1}‖`...
     pub tolerance: f64,
     /// ... and the natural-map residual
-    /// ([`TangentialProblem::natural_map_residual`](crate::contact::delassus::TangentialProblem::natural_map_residual))
+    /// (THEORY §4.2, `TangentialProblem::natural_map_residual`)
     /// is at most this.
     pub residual_tolerance: f64,
     /// Sweep bound; a step that reaches it is counted as non-converged.
@@ -147,7 +157,7 @@ pub struct SolverStatistics {
     /// (tolerated), Active Set direct solves whose `H_SS` was singular (regularised).
     pub singular_delassus: u64,
     /// Largest natural-map residual of a step (relative; see
-    /// [`TangentialProblem::natural_map_residual`](crate::contact::delassus::TangentialProblem::natural_map_residual)).
+    /// `TangentialProblem::natural_map_residual`, THEORY §4.2).
     pub residual_max: f64,
     /// Sum of the steps' residuals (the mean is `residual_sum / lagrange_steps`).
     pub residual_sum: f64,

@@ -25,8 +25,8 @@ use crate::contact::friction::Slide;
 use crate::contact::tangential::SolverStatistics;
 use crate::error::{Error, Result};
 use crate::integrator::stability::stable_time_step;
-use crate::numerics::{Lanes, Portable};
 use crate::model::Model;
+use crate::numerics::{Lanes, Portable};
 use crate::settings::RunSettings;
 use crate::settings::run::round_down;
 
@@ -212,7 +212,7 @@ impl<'m> Simulation<'m> {
     }
 
     /// Statistics in progress, whose finished impacts and blocks may be drained.
-    pub fn statistics_mut(&mut self) -> &mut ContactStatisticsState {
+    pub(crate) fn statistics_mut(&mut self) -> &mut ContactStatisticsState {
         &mut self.state.statistics
     }
 
@@ -331,20 +331,20 @@ impl<'m> Simulation<'m> {
 
     /// Runs the steps with the portable (SSE2 on x86-64) code even when the processor has
     /// AVX2: for comparisons and tests.
-    pub fn use_portable_kernels(&mut self) {
+    pub(crate) fn use_portable_kernels(&mut self) {
         self.work.wide = false;
     }
 
     /// Runs the steps with the code compiled for any contact even when the case is the
     /// common one (`contact_kinds`): for comparisons and tests.
-    pub fn use_general_step(&mut self) {
+    pub(crate) fn use_general_step(&mut self) {
         self.work.common_contacts = false;
     }
 
     /// Whether the steps run the code compiled for the common case: every obstacle a fixed
     /// plane or fixed bars, an undamped normal law, friction by Lagrange multipliers (the same
     /// results as the general code, bit for bit, faster).
-    pub fn runs_common_step(&self) -> bool {
+    pub(crate) fn runs_common_step(&self) -> bool {
         self.work.common_contacts
     }
 

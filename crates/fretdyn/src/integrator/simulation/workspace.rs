@@ -20,11 +20,11 @@ use crate::contact::tangential::penalty::PenaltyContact;
 use crate::contact::tangential::{SolverStatistics, TangentialMethod};
 use crate::error::{Error, Result};
 use crate::integrator::central_difference::{CentralDifference, ModalState};
-use crate::numerics::PaddedRows;
 use crate::loads::fluid_elastic::FluidElasticForce;
 use crate::loads::stepped::SteppedHistory;
 use crate::loads::turbulence::RandomChannels;
 use crate::model::Model;
+use crate::numerics::PaddedRows;
 use crate::settings::RunSettings;
 use crate::structure::modal::project_add;
 

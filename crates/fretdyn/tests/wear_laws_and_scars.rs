@@ -723,18 +723,14 @@ fn bad_scars_and_volumes_give_errors_not_panics() {
 // ---------------------------------------------------------------- case file
 
 fn case_with(obstacle: &str, radius: &str, wear: &str) -> String {
+    const POINT_MASS: &str = include_str!("fixtures/point_mass.toml");
     format!(
         r#"
 [time]
 dt = 1e-6
 duration = 2e-3
 
-[structure]
-type = "point_mass"
-mass = 1.0
-point = "mass"
-position = [0.0, 0.0, 0.0]
-
+{POINT_MASS}
 [initial]
 point = "mass"
 velocity = [0.5, 0.0, -0.5]

@@ -1,4 +1,4 @@
-//! `fretdyn bench --against-c DIR`: fretdyn's step timed side by side with a plain C99
+//! `fretdyn-bench --against-c DIR`: fretdyn's step timed side by side with a plain C99
 //! implementation of the same algorithm (`DIR/step_ref.c`, the yardstick of issue [2.3]),
 //! following `DIR/side_by_side.sh`:
 //!
@@ -20,12 +20,12 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use fretdyn::case::Case;
-use fretdyn::integrator::simulation::{Termination, simulate};
+use fretdyn::Case;
+use fretdyn::integrator::simulation::Termination;
+use fretdyn::simulate;
 
-use crate::Failure;
-use crate::bench::cpu_model;
-use crate::out::{errln, outln};
+use crate::{Failure, cpu_model, errln, outln};
+use std::io::Write as _;
 
 /// The part of the comparison to run (`--only`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -36,7 +36,7 @@ pub enum Part {
     Grid,
 }
 
-/// Options of `fretdyn bench --against-c`.
+/// Options of `fretdyn-bench --against-c`.
 #[derive(Debug, Clone)]
 pub struct Options {
     /// The perf folder (`step_ref.c`, `s1_case.bin`, `grid/`, `fretdyn_cases/`).
@@ -72,7 +72,7 @@ const GRID_CONTACTS: [u32; 4] = [1, 5, 20, 50];
 pub const BEGIN: &str = "<!-- against-c:begin -->";
 pub const END: &str = "<!-- against-c:end -->";
 
-/// Entry point of `fretdyn bench --against-c DIR`.
+/// Entry point of `fretdyn-bench --against-c DIR`.
 pub fn main(options: &Options) -> Result<(), Failure> {
     check_options(options)?;
     let files = Files::check(&options.dir, options.only)?;
@@ -879,9 +879,9 @@ fn write_section(file: &Path, markdown: &str) -> Result<(), Failure> {
     std::fs::write(file, new).map_err(io)
 }
 
-/// The command line as typed, program name shortened to `fretdyn`.
+/// The command line as typed, program name shortened to `fretdyn-bench`.
 fn command_line() -> String {
-    let mut words = vec!["fretdyn".to_string()];
+    let mut words = vec!["fretdyn-bench".to_string()];
     for a in std::env::args().skip(1) {
         if a.is_empty() || a.contains(char::is_whitespace) {
             words.push(format!("'{a}'"));

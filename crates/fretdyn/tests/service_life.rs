@@ -12,31 +12,11 @@ use fretdyn::case::Case;
 /// died out (heavily damped springs, window from 1 s) the mass stands still and the bar slides,
 /// `W = μ N v` exactly, whatever the gap: the bar's recession only moves the mass down.
 fn sliding_mass(wear: &str, life: &str) -> String {
+    const BODY: &str = include_str!("fixtures/sliding_mass.toml");
     format!(
         r#"
 title = "mass sliding on a bar"
-[time]
-dt = 1e-4
-duration = 1.5
-[structure]
-type = "modal"
-frequencies_hz = [5.0, 5.0, 0.0]
-damping_ratio = 0.7
-[[structure.points]]
-name = "mass"
-coords = [0.0, 0.0, 0.0]
-rows = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-[[loads]]
-point = "mass"
-force = [0.0, 0.0, -10.0]
-[[contacts]]
-name = "bar"
-point = "mass"
-obstacle = {{ type = "plane", origin = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0], gap = 0.0, tangent = [1.0, 0.0, 0.0] }}
-motion = {{ type = "velocity", velocity = [0.01, 0.0, 0.0] }}
-normal = {{ stiffness = 1e6, damping = 2000.0 }}
-friction = {{ mu = 0.3 }}
-wear = {wear}
+{BODY}wear = {wear}
 [tangential]
 method = "gauss_seidel"
 [statistics]

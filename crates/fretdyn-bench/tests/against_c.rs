@@ -1,4 +1,4 @@
-//! `fretdyn bench --against-c DIR`: fretdyn and the plain C step of the shared perf folder
+//! `fretdyn-bench --against-c DIR`: fretdyn and the plain C step of the shared perf folder
 //! (`step_ref.c`, an independent implementation of the same algorithm) compute the same
 //! thing on case S1, and the report has its rows. Skipped, with a note, where the perf folder
 //! or gcc is absent.
@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn fretdyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fretdyn"))
+    Command::new(env!("CARGO_BIN_EXE_fretdyn-bench"))
         .args(args)
         .output()
         .expect("fretdyn runs")
@@ -41,7 +41,6 @@ fn row<'a>(text: &'a str, first: &str) -> Vec<&'a str> {
 fn s1_agrees_with_the_c_program_and_is_timed() {
     let Some(dir) = perf_dir() else { return };
     let out = fretdyn(&[
-        "bench",
         "--against-c",
         dir.to_str().unwrap(),
         "--only",
@@ -117,7 +116,6 @@ fn a_different_computation_is_flagged_and_fails() {
     .unwrap();
 
     let out = fretdyn(&[
-        "bench",
         "--against-c",
         copy.to_str().unwrap(),
         "--only",
@@ -145,7 +143,7 @@ fn a_different_computation_is_flagged_and_fails() {
 
 #[test]
 fn missing_folder_is_a_one_line_input_error() {
-    let out = fretdyn(&["bench", "--against-c", "no/such/perf", "--only", "s1"]);
+    let out = fretdyn(&["--against-c", "no/such/perf", "--only", "s1"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
@@ -158,20 +156,12 @@ fn missing_folder_is_a_one_line_input_error() {
 
 #[test]
 fn write_needs_five_reps_and_reps_needs_against_c() {
-    let out = fretdyn(&[
-        "bench",
-        "--against-c",
-        "perf",
-        "--reps",
-        "3",
-        "--write",
-        "PERF.md",
-    ]);
+    let out = fretdyn(&["--against-c", "perf", "--reps", "3", "--write", "PERF.md"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("--reps 5"), "{stderr}");
 
-    let out = fretdyn(&["bench", "--reps", "3"]);
+    let out = fretdyn(&["--reps", "3"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("--against-c"), "{stderr}");
