@@ -4,9 +4,9 @@
 //! `structure/beam.rs`, `integrator/stability.rs`).
 //!
 //! The estimate counts the buffers that `Simulation::allocate`
-//! (`integrator/simulation/mod.rs`), the tangential problem (`contact/delassus.rs`), the
+//! (`integrator/simulation/workspace.rs`), the tangential problem (`contact/delassus/`), the
 //! Active Set solver (`contact/tangential/active_set.rs`), the per-contact statistics
-//! (`results/statistics.rs`) and the turbulence generator (`loads/turbulence.rs`) allocate;
+//! (`accumulate/statistics/`) and the turbulence generator (`loads/turbulence/`) allocate;
 //! `tests/memory.rs` measures them against it. With `m` contacts and `p` modes, the Lagrange
 //! methods hold dense matrices of the `2m` tangential unknowns (the Delassus operator `H`
 //! twice, the solver's work space once, and the Active Set's once more) and rows of `2m × p`:
@@ -24,8 +24,8 @@ use crate::structure::beam::{available_memory, gigabytes};
 const PER_CONTACT: f64 = 40e3;
 
 /// Dense `(2m)²` matrices of `f64` the tangential problem of a Lagrange method holds: `H` of
-/// the fixed contacts and `H` of the closed ones (`contact/delassus.rs`), and the work space
-/// of the step (`4m²` values, `integrator/simulation/tangential.rs`).
+/// the fixed contacts and `H` of the closed ones (`contact/delassus/`), and the work space
+/// of the step (`4m²` values, `integrator/simulation/lagrange.rs`).
 const LAGRANGE_MATRICES: f64 = 3.0;
 
 /// One more for the Active Set's work space (`contact/tangential/active_set.rs`).

@@ -8,7 +8,7 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 pub const IMPACTS_FILE: &str = "impacts.csv";
 pub const BLOCKS_FILE: &str = "blocks.csv";
 pub const RESULTS_FILE: &str = "results.npz";
-/// `results.nc`, written with the `netcdf` feature (`results/netcdf.rs`).
+/// `results.nc`, written with the `netcdf` feature (`output/netcdf.rs`).
 pub const NETCDF_FILE: &str = "results.nc";
 
 /// The global attributes of `results.nc` that the library does not know: a front end gives

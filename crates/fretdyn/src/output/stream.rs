@@ -13,7 +13,7 @@
 //!   the length of every file at that step ([`super::checkpoint`]);
 //! - at the end, `results.npz`, packed from `series/` (copied entry by entry, never whole in
 //!   memory), then (with the `netcdf` feature) `results.nc`, the same arrays with names and
-//!   units, packed from `series/` block by block (`results/netcdf.rs` says why at the
+//!   units, packed from `series/` block by block (`output/netcdf.rs` says why at the
 //!   end and not at each flush); after which `series/` is removed.
 //!
 //! A run ends with a checkpoint at its last step, then [`StreamObserver::finished`] (where a
