@@ -11,7 +11,7 @@
 //!
 //! The imports are read from the text (comments, strings and `#[cfg(test)]` modules left out):
 //! `use crate::…`, `use super::…`, `use self::…`, `use child::…` with their `{…}` groups, and
-//! every `crate::a::b` path in the code.
+//! every `crate::a::b` and `super::a::b` path in the code.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -238,8 +238,11 @@ fn imports(code: &str) -> Vec<Import> {
             out.push(Import { path, reexport });
         }
     }
-    // inline `crate::…` paths
-    for (k, _) in code.match_indices("crate::") {
+    // inline `crate::…` and `super::…` paths
+    let inline = code
+        .match_indices("crate::")
+        .chain(code.match_indices("super::"));
+    for (k, _) in inline {
         let preceded = code[..k].chars().next_back();
         if preceded.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':') {
             continue;
@@ -458,7 +461,7 @@ fn the_checker_sees_cycles_and_ignores_what_is_not_code() {
         ]
     );
     let code = code_only(
-        "// use crate::x;\nlet s = \"crate::y\";\npub use child::Z;\nuse crate::w::V;\n#[cfg(test)]\nmod tests { use crate::t; }\n",
+        "// use crate::x;\nlet s = \"crate::y\";\npub use child::Z;\nuse crate::w::V;\nfn f() { super::s::g() }\n#[cfg(test)]\nmod tests { use crate::t; }\n",
     );
     let found: Vec<(String, bool)> = imports(&code)
         .into_iter()
@@ -469,7 +472,8 @@ fn the_checker_sees_cycles_and_ignores_what_is_not_code() {
         [
             ("child::Z".to_string(), true),
             ("crate::w::V".to_string(), false),
-            ("crate::w::V".to_string(), false)
+            ("crate::w::V".to_string(), false),
+            ("super::s::g".to_string(), false)
         ]
     );
     let m = |s: &str| s.split("::").map(String::from).collect::<Vec<_>>();
