@@ -397,7 +397,7 @@ fn folders_import_only_lower_layers() {
             continue;
         };
         for to in targets {
-            if to.first() != from.first() && !rank(to).is_some_and(|t| t < r) {
+            if to.first() != from.first() && rank(to).is_none_or(|t| t >= r) {
                 wrong.push(format!(
                     "{} imports {} (a higher or unranked layer)",
                     from.join("::"),
