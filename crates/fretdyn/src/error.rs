@@ -94,6 +94,19 @@ impl Error {
         }
     }
 
+    /// The error of a part (a structure of several) as the whole sees it: an
+    /// [`Error::Invalid`]'s field prefixed with `prefix` (`structures[1].` + `time.dt`); other
+    /// errors unchanged.
+    pub fn within(self, prefix: &str) -> Self {
+        match self {
+            Error::Invalid { field, message } => Error::Invalid {
+                field: format!("{prefix}.{field}"),
+                message,
+            },
+            other => other,
+        }
+    }
+
     pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),

@@ -80,13 +80,100 @@ impl NormalLaw {
     }
 }
 
+/// The second body of a two-body contact (THEORY §16): point B of a structure (the same or
+/// another one) that the contact's point A rattles against.
+///
+/// Everything the contact computes — penetration, frame, velocity, forces, Delassus rows —
+/// is that of the **relative point** `x = x_A − x_B` (reference position `x0_A − x0_B`, rows
+/// `Φ_A − Φ_B`), seen by the contact's obstacle expressed in relative coordinates: the
+/// force `R` it finds acts on A, `−R` on B (`f_q = (Φ_A − Φ_B)ᵀ R`). On the surfaces of radii
+/// `R_A`, `R_B` around the points (tube or bar surfaces), the contact points are
+/// `x_A − R_A n` and `x_B + R_B n`, whose relative velocity is
+/// `u̇_A − u̇_B + n × (R_A θ̇_A + R_B θ̇_B)`: the relative point's rotation rows are
+/// `(R_A Θ_A + R_B Θ_B) / (R_A + R_B)` and the contact's radius is `R_A + R_B`, so that
+/// [`Contact::surface_rows`] forms exactly these rows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pair {
+    /// Index of point B in the modal basis.
+    pub other: usize,
+    /// Surface radii `[R_A, R_B]` around points A and B, m (0: the contact is at the point).
+    pub radii: [f64; 2],
+    /// The relative point A − B.
+    relative: Point,
+}
+
+impl Pair {
+    /// The pair of points `a` (index in the contact) and `b` (index `other`), with the surface
+    /// radii `radii`; `field` names the contact in error messages.
+    pub fn new(a: &Point, other: usize, b: &Point, radii: [f64; 2], field: &str) -> Result<Self> {
+        for (r, side) in radii.iter().zip(["A", "B"]) {
+            if !(r.is_finite() && *r >= 0.0) {
+                return Err(Error::invalid(
+                    format!("{field}.radii"),
+                    format!("the radius of side {side} must be ≥ 0 in m (got {r})"),
+                ));
+            }
+        }
+        if a.rows.len() != b.rows.len() {
+            return Err(Error::invalid(
+                format!("{field}.other"),
+                format!(
+                    "points '{}' and '{}' have rows of different lengths",
+                    a.name, b.name
+                ),
+            ));
+        }
+        let total = radii[0] + radii[1];
+        let mut rotations = Vec::new();
+        if total > 0.0 {
+            rotations = vec![0.0; a.rows.len()];
+            for (r, point) in radii.iter().zip([a, b]) {
+                if *r == 0.0 {
+                    continue;
+                }
+                if point.rotations.len() != a.rows.len() {
+                    return Err(Error::invalid(
+                        format!("{field}.radii"),
+                        format!(
+                            "a contact on the surface around point '{}' needs its rotations: use a tube or beam structure, or set its radius to 0",
+                            point.name
+                        ),
+                    ));
+                }
+                let w = r / total;
+                for (o, t) in rotations.iter_mut().zip(&point.rotations) {
+                    *o += w * t;
+                }
+            }
+        }
+        Ok(Self {
+            other,
+            radii,
+            relative: Point {
+                name: format!("{}-{}", a.name, b.name),
+                coords: a.coords - b.coords,
+                rows: a.rows.iter().zip(&b.rows).map(|(x, y)| x - y).collect(),
+                rotations,
+            },
+        })
+    }
+
+    /// The relative point A − B.
+    pub fn relative(&self) -> &Point {
+        &self.relative
+    }
+}
+
 /// One contact of the model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Contact {
     /// Name, used in outputs.
     pub name: String,
-    /// Index of the structure point in the modal basis.
+    /// Index of the structure point in the modal basis (point A of a two-body contact).
     pub point: usize,
+    /// The second body of a two-body contact, `None` for a contact with an obstacle (the
+    /// common case). Build with [`Contact::between`].
+    pub pair: Option<Box<Pair>>,
     /// The obstacle.
     pub obstacle: Obstacle,
     /// Prescribed rigid motion of the obstacle ([`Motion::Fixed`] by default).
@@ -116,12 +203,70 @@ impl Contact {
         Self {
             name: name.into(),
             point,
+            pair: None,
             obstacle,
             motion: Motion::Fixed,
             radius: 0.0,
             normal,
             friction,
         }
+    }
+
+    /// A two-body contact between point `a` and point `b` of `points` (THEORY §16), with the
+    /// surface radii `radii = [R_A, R_B]` around them; `obstacle` is in relative coordinates
+    /// (the position `x_A − x_B`, reference `x0_A − x0_B`): a plane of normal `n` pointing
+    /// from B to A for point against point along `n`, a cylinder for tubes side by side.
+    #[allow(clippy::too_many_arguments)]
+    pub fn between(
+        name: impl Into<String>,
+        a: usize,
+        b: usize,
+        points: &[Point],
+        radii: [f64; 2],
+        obstacle: Obstacle,
+        normal: NormalLaw,
+        friction: Coulomb,
+    ) -> Result<Self> {
+        let name = name.into();
+        let field = format!("contact '{name}'");
+        let (pa, pb) = match (points.get(a), points.get(b)) {
+            (Some(pa), Some(pb)) => (pa, pb),
+            _ => {
+                return Err(Error::invalid(
+                    format!("{field}.other"),
+                    "refers to no point of the model",
+                ));
+            }
+        };
+        if a == b {
+            return Err(Error::invalid(
+                format!("{field}.other"),
+                format!(
+                    "is the contact's own point '{}': name another point",
+                    pa.name
+                ),
+            ));
+        }
+        let pair = Pair::new(pa, b, pb, radii, &field)?;
+        let mut contact = Self::new(name, a, obstacle, normal, friction);
+        contact.radius = radii[0] + radii[1];
+        contact.pair = Some(Box::new(pair));
+        Ok(contact)
+    }
+
+    /// The point the contact sees: its structure point, or for a two-body contact the
+    /// relative point A − B ([`Pair`]).
+    #[inline(always)]
+    pub fn point_in<'a>(&'a self, points: &'a [Point]) -> &'a Point {
+        match &self.pair {
+            None => &points[self.point],
+            Some(pair) => &pair.relative,
+        }
+    }
+
+    /// Index of point B of a two-body contact.
+    pub fn other(&self) -> Option<usize> {
+        self.pair.as_ref().map(|p| p.other)
     }
 
     /// Frame of the obstacle at time `t` for the point's physical position `x` (the tube axis

@@ -218,7 +218,7 @@ fn contact_springs(
     kt: f64,
     ct: f64,
 ) -> Vec<Spring> {
-    let point = &model.basis.points[contact.point];
+    let point = contact.point_in(&model.basis.points);
     let (normals, tangents) = contact.obstacle.penalty_directions();
     let (kn, cn) = (contact.normal.stiffness, contact.normal.damping);
     let mut springs = Vec::new();
@@ -336,7 +336,7 @@ fn check_radius(model: &Model, index: usize) -> Result<()> {
     if !contact.at_surface() {
         return Ok(());
     }
-    let point = &model.basis.points[contact.point];
+    let point = contact.point_in(&model.basis.points);
     let r = contact.radius;
     let reach = r * largest(&point.rotations) * model.basis.modes() as f64;
     if (contact.normal.stiffness.max(1.0) * reach * reach).is_finite() {
@@ -356,7 +356,7 @@ fn check_radius(model: &Model, index: usize) -> Result<()> {
 /// the modal mass of its point (tiny when a mass or a density is in the wrong unit).
 fn not_finite_contact(model: &Model, index: usize) -> Error {
     let contact = &model.contacts[index];
-    let point = &model.basis.points[contact.point];
+    let point = contact.point_in(&model.basis.points);
     // the point's modal mass, 1/max|Φ|² (exact for a point mass)
     let modal_mass = (1.0 / largest(&point.rows)).powi(2);
     Error::invalid(
@@ -436,7 +436,7 @@ pub fn impact_resolution(model: &Model, dt: f64) -> Vec<ImpactResolution> {
     };
     let mut out = Vec::new();
     for (index, contact) in model.contacts.iter().enumerate() {
-        let rows = &model.basis.points[contact.point].rows;
+        let rows = &contact.point_in(&model.basis.points).rows;
         let p = rows.len() / 3;
         if p == 0 || !(contact.normal.stiffness > 0.0) {
             continue;

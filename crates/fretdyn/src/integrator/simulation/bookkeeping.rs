@@ -69,7 +69,7 @@ impl Simulation<'_> {
         for (k, (s, c)) in states.zip(&self.model.contacts).enumerate() {
             if self.work.frame_rows[k].is_some() {
                 // a plane's or bars' 3-D position is formed for the samples only
-                let pt = &self.model.basis.points[c.point];
+                let pt = c.point_in(&self.model.basis.points);
                 s.x = pt.coords + recombine(&pt.rows, &x.q);
             }
             let vt = s.tangential_velocity();

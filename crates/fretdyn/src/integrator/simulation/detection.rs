@@ -49,7 +49,7 @@ impl Simulation<'_> {
                     rows.update(state.distance, &mut state.frame);
                 }
                 None => {
-                    let pt = &self.model.basis.points[c.point];
+                    let pt = c.point_in(&self.model.basis.points);
                     state.x = pt.coords + recombine_with::<K>(&pt.rows, &x.q);
                     state.frame = c.frame(&state.x, t);
                 }
@@ -57,7 +57,7 @@ impl Simulation<'_> {
             if !detected.status(k, state) {
                 continue;
             }
-            let pt = &self.model.basis.points[c.point];
+            let pt = c.point_in(&self.model.basis.points);
             // an open contact's velocity is only needed at output samples
             if !O::is_fixed(c) {
                 state.frame.velocity = c.motion.at(t).1;
@@ -159,7 +159,7 @@ impl Simulation<'_> {
                 state.set_velocity::<K>(kinematics, O::damped(c), &x.qd, true)
             }
             None => {
-                let pt = &self.model.basis.points[c.point];
+                let pt = c.point_in(&self.model.basis.points);
                 if c.at_surface() && !state.closed {
                     let out = &mut w.surface_rows[3 * p * k..3 * p * (k + 1)];
                     c.surface_rows(pt, &state.frame.normal, out);

@@ -179,7 +179,7 @@ impl<'m> Workspace<'m> {
         let frame_rows: Vec<Option<FrameRows>> = model
             .contacts
             .iter()
-            .map(|c| FrameRows::new(c, &model.basis.points[c.point]))
+            .map(|c| FrameRows::new(c, c.point_in(&model.basis.points)))
             .collect();
         let mut surface_rows = vec![0.0; 3 * p * nc];
         for (k, (c, rows)) in model.contacts.iter().zip(&frame_rows).enumerate() {
@@ -188,7 +188,7 @@ impl<'m> Workspace<'m> {
             {
                 // a plane: the normal, and so the surface rows, never change
                 c.surface_rows(
-                    &model.basis.points[c.point],
+                    c.point_in(&model.basis.points),
                     &rows.frame(0.0).normal,
                     &mut surface_rows[3 * p * k..3 * p * (k + 1)],
                 );
@@ -289,7 +289,7 @@ impl Tangential {
         let mut problem = TangentialProblem::new(model.basis.modes(), nc);
         for (k, c) in model.contacts.iter().enumerate() {
             if let Some(t) = c.fixed_tangents() {
-                let point = &model.basis.points[c.point];
+                let point = c.point_in(&model.basis.points);
                 let mut rows = point.rows.clone();
                 if c.at_surface() {
                     // a plane: the normal never changes
@@ -327,7 +327,7 @@ pub(super) fn contact_rows<'a>(model: &'a Model, surface_rows: &'a [f64], k: usi
         let p = model.basis.modes();
         &surface_rows[3 * p * k..3 * p * (k + 1)]
     } else {
-        &model.basis.points[c.point].rows
+        &c.point_in(&model.basis.points).rows
     }
 }
 

@@ -3,6 +3,10 @@
 //! the [`Model`] the integrator steps — modal basis, contacts, loads and initial state,
 //! everything a run needs except the numerical settings (THEORY §1, §2).
 
+mod structures;
+
+pub use structures::StructureRange;
+
 use nalgebra::DMatrix;
 
 use crate::contact::Contact;
@@ -70,6 +74,9 @@ pub struct Model {
     pub wear: Vec<Option<crate::wear::ContactWear>>,
     /// Initial state.
     pub initial: InitialState,
+    /// For a model of several structures ([`Model::union`], THEORY §16), where each one's
+    /// modes, points and contacts are; empty for a model of one structure.
+    pub structures: Vec<StructureRange>,
 }
 
 impl Model {
@@ -90,6 +97,7 @@ impl Model {
                 q: vec![0.0; p],
                 qdot: vec![0.0; p],
             },
+            structures: Vec::new(),
         }
     }
 
@@ -165,7 +173,28 @@ impl Model {
                     "refers to no point of the structure",
                 ));
             }
-            c.validate(&self.basis.points[c.point], &format!("contacts[{k}]"))?;
+            if let Some(pair) = &c.pair {
+                let field = format!("contacts[{k}]");
+                let (a, b) = (
+                    &self.basis.points[c.point],
+                    self.basis.points.get(pair.other),
+                );
+                let Some(b) = b else {
+                    return Err(Error::invalid(
+                        format!("{field}.other"),
+                        "refers to no point of the model",
+                    ));
+                };
+                // the relative point is derived data: it must be the one of the points now
+                let fresh = crate::contact::Pair::new(a, pair.other, b, pair.radii, &field)?;
+                if fresh != **pair || c.radius != pair.radii[0] + pair.radii[1] {
+                    return Err(Error::invalid(
+                        field,
+                        "its relative point no longer matches its points' rows (the basis changed after Contact::between): build the contact again",
+                    ));
+                }
+            }
+            c.validate(c.point_in(&self.basis.points), &format!("contacts[{k}]"))?;
         }
         for (k, l) in self.loads.iter().enumerate() {
             if l.point >= np {
