@@ -80,7 +80,7 @@ impl NormalLaw {
     }
 }
 
-/// The second body of a two-body contact (THEORY §16): point B of a structure (the same or
+/// The second body of a two-body contact (THEORY §15): point B of a structure (the same or
 /// another one) that the contact's point A rattles against.
 ///
 /// Everything the contact computes — penetration, frame, velocity, forces, Delassus rows —
@@ -212,7 +212,7 @@ impl Contact {
         }
     }
 
-    /// A two-body contact between point `a` and point `b` of `points` (THEORY §16), with the
+    /// A two-body contact between point `a` and point `b` of `points` (THEORY §15), with the
     /// surface radii `radii = [R_A, R_B]` around them; `obstacle` is in relative coordinates
     /// (the position `x_A − x_B`, reference `x0_A − x0_B`): a plane of normal `n` pointing
     /// from B to A for point against point along `n`, a cylinder for tubes side by side.

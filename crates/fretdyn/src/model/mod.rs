@@ -74,7 +74,7 @@ pub struct Model {
     pub wear: Vec<Option<crate::wear::ContactWear>>,
     /// Initial state.
     pub initial: InitialState,
-    /// For a model of several structures ([`Model::union`], THEORY §16), where each one's
+    /// For a model of several structures ([`Model::union`], THEORY §15), where each one's
     /// modes, points and contacts are; empty for a model of one structure.
     pub structures: Vec<StructureRange>,
 }

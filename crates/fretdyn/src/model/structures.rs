@@ -1,4 +1,4 @@
-//! Several structures in one model (THEORY §16): each reduced on its own modes, the model's
+//! Several structures in one model (THEORY §15): each reduced on its own modes, the model's
 //! basis their union. With `q = (q_1, …, q_S)` the modal coordinates of the structures side
 //! by side, the mass, damping and stiffness are block diagonal, a point of structure `s` has
 //! rows `Φ = [0 … Φ_s … 0]`, and only the two-body contacts couple the blocks (their rows
@@ -30,7 +30,7 @@ pub struct StructureRange {
 }
 
 impl Model {
-    /// The model of several structures side by side (THEORY §16), from each one's own model:
+    /// The model of several structures side by side (THEORY §15), from each one's own model:
     /// bases block diagonal, points and contacts named `structure.name`, loads, turbulence and
     /// fluid-elastic forces acting on their structure's modes only, initial states side by
     /// side. Two-body contacts between structures are added afterwards
