@@ -27,7 +27,7 @@ impl WearMap {
             .map(|c| match c.obstacle {
                 Obstacle::Circle(_) | Obstacle::Polygon(_) => vec![0.0; angular_bins.max(1)],
                 Obstacle::BiPlane(_) => vec![0.0; 2],
-                Obstacle::Plane(_) => vec![0.0; 1],
+                Obstacle::Plane(_) | Obstacle::Cylinder(_) => vec![0.0; 1],
             })
             .collect::<Vec<_>>();
         Self {

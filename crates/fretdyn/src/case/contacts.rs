@@ -9,7 +9,7 @@ use super::shared::{TubeModel, point_index, v3};
 use super::wear::WearInput;
 use crate::contact::friction::Coulomb;
 use crate::contact::motion::Motion;
-use crate::contact::obstacle::{BiPlane, Circle, Obstacle, Plane, Polygon};
+use crate::contact::obstacle::{BiPlane, Circle, Cylinder, Obstacle, Plane, Polygon};
 use crate::contact::{Contact, NormalLaw};
 use crate::error::{Error, Result, number};
 use crate::model::Model;
@@ -160,6 +160,24 @@ pub(super) fn build_contacts(
                     v3(axis),
                     reference.map(v3),
                     vertices,
+                    &format!("{field}.obstacle"),
+                )?)
+            }
+            ObstacleInput::Cylinder {
+                centre,
+                axis,
+                radius,
+            } => {
+                let Some(radius) = radius else {
+                    return Err(Error::invalid(
+                        format!("{field}.obstacle.radius"),
+                        "a cylinder needs its radius, m (the distance from its axis at which the point touches it)",
+                    ));
+                };
+                Obstacle::Cylinder(Cylinder::new(
+                    v3(centre),
+                    v3(axis),
+                    radius,
                     &format!("{field}.obstacle"),
                 )?)
             }

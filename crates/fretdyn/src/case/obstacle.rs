@@ -1,5 +1,5 @@
 //! `obstacle = { type = … }` of a `[[contacts]]` entry: a plane, a bi-plane (two parallel
-//! planes), a circular hole or a polygonal hole, as the case file gives it (THEORY §3).
+//! planes), a circular hole, a polygonal hole or a rod (cylinder), as the case file gives it (THEORY §3).
 
 use serde::Deserialize;
 
@@ -36,5 +36,14 @@ pub(super) enum ObstacleInput {
         vertices: Option<Vec<[f64; 2]>>,
         /// Vertices as `[angle_deg, radius]` pairs.
         polar: Option<Vec<[f64; 2]>>,
+    },
+    /// A rod the point stays outside of (tube against tube side by side, THEORY §15).
+    Cylinder {
+        #[serde(default)]
+        centre: [f64; 3],
+        axis: [f64; 3],
+        /// Distance between the axes at contact, m (for two tubes: the sum of their outer
+        /// radii, the default of a two-body contact).
+        radius: Option<f64>,
     },
 }

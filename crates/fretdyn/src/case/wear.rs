@@ -125,7 +125,8 @@ impl WearInput {
             (
                 ScarInput::FlatBar { .. } | ScarInput::Tube { .. },
                 ObstacleInput::Plane { .. } | ObstacleInput::BiPlane { .. },
-            ) | (ScarInput::DrilledHole { .. }, ObstacleInput::Circle { .. })
+            ) | (ScarInput::Tube { .. }, ObstacleInput::Cylinder { .. })
+                | (ScarInput::DrilledHole { .. }, ObstacleInput::Circle { .. })
                 | (
                     ScarInput::BroachedHole { .. },
                     ObstacleInput::Polygon { .. }
@@ -133,14 +134,15 @@ impl WearInput {
         );
         if !suits {
             let needs = match self.scar {
-                ScarInput::FlatBar { .. } | ScarInput::Tube { .. } => "a plane or bi_plane",
+                ScarInput::FlatBar { .. } => "a plane or bi_plane",
+                ScarInput::Tube { .. } => "a plane, bi_plane or cylinder",
                 ScarInput::DrilledHole { .. } => "a circle",
                 ScarInput::BroachedHole { .. } => "a polygon",
             };
             return Err(Error::invalid(
                 format!("{sf}.type"),
                 format!(
-                    "a '{kind}' scar needs {needs} obstacle, this contact's obstacle is a {}: give the scar type of the support (flat_bar or tube for planes, drilled_hole for a circle, broached_hole for a polygon)",
+                    "a '{kind}' scar needs {needs} obstacle, this contact's obstacle is a {}: give the scar type of the support (flat_bar or tube for planes, tube for a cylinder, drilled_hole for a circle, broached_hole for a polygon)",
                     obstacle_name(obstacle)
                 ),
             ));
@@ -233,5 +235,6 @@ fn obstacle_name(o: &ObstacleInput) -> &'static str {
         ObstacleInput::Circle { .. } => "circle",
         ObstacleInput::BiPlane { .. } => "bi_plane",
         ObstacleInput::Polygon { .. } => "polygon",
+        ObstacleInput::Cylinder { .. } => "cylinder",
     }
 }

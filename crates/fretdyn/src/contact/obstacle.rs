@@ -449,6 +449,63 @@ impl Polygon {
     }
 }
 
+/// A rod the point must stay outside of — with a two-body contact ([`crate::contact::Pair`]),
+/// **tube against tube side by side** (THEORY §15): the axis of tube B through `c` (in
+/// relative coordinates, B's point: `c = 0`), along `a`, and the distance `ρ_c = R_A + R_B`
+/// between the two axes at contact. With `r` the offset of the point (A's axis) from B's
+/// axis normal to `a`: `δ = ρ_c − |r|`, `n = r/|r|` (from B to A), tangents `[a × n, a]`
+/// (circumferential, axial). Valid for parallel axes; crossing tubes touch along their
+/// common normal, a plane.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cylinder {
+    centre: Vector3<f64>,
+    axis: Vector3<f64>,
+    radius: f64,
+    /// An in-plane unit vector, for the frame of a point exactly on the axis.
+    e1: Vector3<f64>,
+}
+
+impl Cylinder {
+    /// Builds a rod of radius `radius` (for two tubes: the sum of their outer radii) around
+    /// the line through `centre` along `axis`; `field` names it in error messages.
+    pub fn new(centre: Vector3<f64>, axis: Vector3<f64>, radius: f64, field: &str) -> Result<Self> {
+        let line = Circle::new(centre, axis, 0.0, field)?;
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(Error::invalid(
+                format!("{field}.radius"),
+                format!(
+                    "must be the distance between the axes at contact (the sum of the two tubes' outer radii) > 0, in m (got {radius})"
+                ),
+            ));
+        }
+        Ok(Self {
+            centre,
+            axis: line.axis,
+            radius,
+            e1: line.e1,
+        })
+    }
+
+    #[inline]
+    fn frame(&self, x: &Vector3<f64>) -> ContactFrame {
+        let d = x - self.centre;
+        let r = d - self.axis * self.axis.dot(&d);
+        let rho = r.norm();
+        let radial = if rho > 0.0 { r / rho } else { self.e1 };
+        ContactFrame {
+            penetration: self.radius - rho,
+            normal: radial,
+            tangents: [self.axis.cross(&radial), self.axis],
+            velocity: Vector3::zeros(),
+        }
+    }
+
+    /// The distance between the axes at contact, m.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+}
+
 /// The obstacles fretdyn knows.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Obstacle {
@@ -460,6 +517,8 @@ pub enum Obstacle {
     BiPlane(BiPlane),
     /// Point–polygon contact: a tube in a broached hole.
     Polygon(Polygon),
+    /// Point outside a rod: a tube against a parallel tube (THEORY §15).
+    Cylinder(Cylinder),
 }
 
 impl Obstacle {
@@ -471,6 +530,7 @@ impl Obstacle {
             Obstacle::Circle(c) => c.frame(x),
             Obstacle::BiPlane(b) => b.frame(x),
             Obstacle::Polygon(p) => p.frame(x),
+            Obstacle::Cylinder(c) => c.frame(x),
         }
     }
 
@@ -496,6 +556,11 @@ impl Obstacle {
             Obstacle::Polygon(p) => {
                 let d = x - p.centre;
                 Vector2::new(d.dot(&p.e1), d.dot(&p.e2))
+            }
+            Obstacle::Cylinder(c) => {
+                let d = x - c.centre;
+                let e2 = c.axis.cross(&c.e1);
+                Vector2::new(d.dot(&c.e1), d.dot(&e2))
             }
         }
     }
@@ -536,6 +601,11 @@ impl Obstacle {
                 worn.scar = Some(Box::new(profile.clone()));
                 Ok(Obstacle::Polygon(worn))
             }
+            (Obstacle::Cylinder(c), ObstacleWear::Uniform(d)) if depth_ok(*d) && *d < c.radius => {
+                let mut worn = c.clone();
+                worn.radius -= d;
+                Ok(Obstacle::Cylinder(worn))
+            }
             (_, ObstacleWear::Uniform(_)) => Err(bad("a uniform depth ≥ 0")),
             (_, ObstacleWear::Sides { .. }) => Err(bad("two side depths ≥ 0")),
             (_, ObstacleWear::Angular(_)) => Err(bad("a depth profile around a hole")),
@@ -549,11 +619,12 @@ impl Obstacle {
             Obstacle::Circle(_) => "circle",
             Obstacle::BiPlane(_) => "bi_plane",
             Obstacle::Polygon(_) => "polygon",
+            Obstacle::Cylinder(_) => "cylinder",
         }
     }
 
-    /// The boundary of a hole in its [`local`](Self::local) axes (closed: the last point is
-    /// the first), for orbit plots; `None` for planes and bars.
+    /// The boundary of a hole, or of a rod, in its [`local`](Self::local) axes (closed: the
+    /// last point is the first), for orbit plots; `None` for planes and bars.
     pub fn outline(&self) -> Option<Vec<[f64; 2]>> {
         match self {
             Obstacle::Circle(c) => Some(
@@ -572,14 +643,25 @@ impl Obstacle {
                     .map(|v| [v.x, v.y])
                     .collect(),
             ),
+            Obstacle::Cylinder(c) => Some(
+                (0..=180)
+                    .map(|k| {
+                        let a = std::f64::consts::TAU * k as f64 / 180.0;
+                        [c.radius * a.cos(), c.radius * a.sin()]
+                    })
+                    .collect(),
+            ),
             Obstacle::Plane(_) | Obstacle::BiPlane(_) => None,
         }
     }
 
-    /// True for holes (circle, polygon): their [`local`](Self::local) position is an
-    /// in-plane offset whose radius and angle are meaningful.
+    /// True for holes (circle, polygon) and rods (cylinder): their [`local`](Self::local)
+    /// position is an in-plane offset whose radius and angle are meaningful.
     pub fn is_hole(&self) -> bool {
-        matches!(self, Obstacle::Circle(_) | Obstacle::Polygon(_))
+        matches!(
+            self,
+            Obstacle::Circle(_) | Obstacle::Polygon(_) | Obstacle::Cylinder(_)
+        )
     }
 
     /// For planes and bars, whose normal never turns: `(n, x0, gap, two-sided)`, with which
@@ -589,7 +671,7 @@ impl Obstacle {
         match self {
             Obstacle::Plane(p) => Some((p.normal, p.origin, p.gap, false)),
             Obstacle::BiPlane(b) => Some((b.normal, b.origin, b.gap, true)),
-            Obstacle::Circle(_) | Obstacle::Polygon(_) => None,
+            Obstacle::Circle(_) | Obstacle::Polygon(_) | Obstacle::Cylinder(_) => None,
         }
     }
 
@@ -599,7 +681,7 @@ impl Obstacle {
         match self {
             Obstacle::Plane(p) => Some(p.tangents),
             Obstacle::BiPlane(b) => Some(b.tangents),
-            Obstacle::Circle(_) | Obstacle::Polygon(_) => None,
+            Obstacle::Circle(_) | Obstacle::Polygon(_) | Obstacle::Cylinder(_) => None,
         }
     }
 
@@ -615,6 +697,10 @@ impl Obstacle {
                 (vec![c.e1, e2], vec![c.e1, e2, c.axis])
             }
             Obstacle::Polygon(p) => (vec![p.e1, p.e2], vec![p.e1, p.e2, p.axis]),
+            Obstacle::Cylinder(c) => {
+                let e2 = c.axis.cross(&c.e1);
+                (vec![c.e1, e2], vec![c.e1, e2, c.axis])
+            }
         }
     }
 }
