@@ -133,8 +133,8 @@ fn fretdyn_forces(row: &Row, dt: f64) -> Histories {
     for i in 0..rec.len() {
         let k = (rec.t[i] / dt).round() as usize;
         assert!((rec.t[i] - k as f64 * dt).abs() < 1e-9 * dt);
-        for c in 0..2 {
-            out[c][k] = rec.normal_force[[i, c]];
+        for (c, history) in out.iter_mut().enumerate() {
+            history[k] = rec.normal_force[[i, c]];
         }
     }
     // nothing moves across the line
@@ -251,8 +251,8 @@ fn reference_forces(row: &Row, dt: f64, substeps: usize) -> Reference {
             t = end;
         }
         let d = penetrations(row, &y);
-        for c in 0..2 {
-            out[c][i] = row.stiffness[c] * d[c].max(0.0);
+        for (c, history) in out.iter_mut().enumerate() {
+            history[i] = row.stiffness[c] * d[c].max(0.0);
         }
     }
     Reference {
