@@ -5,25 +5,17 @@ use fretdyn::contact::friction::Coulomb;
 use fretdyn::contact::motion::Motion;
 use fretdyn::contact::obstacle::{Circle, Obstacle, Plane};
 use fretdyn::contact::tangential::{
-    ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
+    ActiveSetSettings, GaussSeidelSettings, PenaltySettings, TangentialMethod,
 };
 use fretdyn::contact::{Contact, NormalLaw};
-use fretdyn::integrator::simulation::{RunResults, RunSettings, simulate};
+use fretdyn::integrator::simulation::{RunResults, simulate};
 use fretdyn::loads::{BaseAcceleration, PointLoad, TimeHistory};
 use fretdyn::model::Model;
 use fretdyn::structure::modal::{ModalBasis, Point};
 use nalgebra::Vector3;
-
-fn settings(method: TangentialMethod, dt: f64, steps: u64) -> RunSettings {
-    RunSettings {
-        dt,
-        steps,
-        method,
-        stick_velocity: StickVelocity::HalfStep,
-        output_every: 1,
-        statistics: Default::default(),
-    }
-}
+#[path = "common/every_step.rs"]
+mod every_step;
+use every_step::every_step as settings;
 
 fn lagrange_methods() -> [(&'static str, TangentialMethod); 2] {
     [

@@ -5,14 +5,14 @@
 #[path = "common/mode_truncation.rs"]
 mod mode_truncation;
 use mode_truncation::with_modes;
+#[path = "common/tube_runs.rs"]
+mod tube_runs;
 use std::path::Path;
+use tube_runs::{lagrange, max_abs, penalty, run};
 
 use fretdyn::case::Case;
-use fretdyn::contact::tangential::{
-    ActiveSetSettings, GaussSeidelSettings, PenaltySettings, StickVelocity, TangentialMethod,
-};
-use fretdyn::integrator::simulation::{RunResults, RunSettings, simulate};
-use fretdyn::model::Model;
+use fretdyn::contact::tangential::TangentialMethod;
+use fretdyn::integrator::simulation::simulate;
 
 /// A clamped–clamped 1 m tube of 10 elements (54 free DOFs, all kept), one mid-span contact
 /// on the tube surface (rotations enter its rows), a second one on the side, Rayleigh damping.
@@ -72,35 +72,6 @@ force = [{fx}, -60.0, 40.0]
 history = {{ type = "harmonic", frequency_hz = 90.0 }}
 "#
     )
-}
-
-fn lagrange() -> [TangentialMethod; 2] {
-    [
-        TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
-        TangentialMethod::ActiveSet(ActiveSetSettings::default()),
-    ]
-}
-
-fn penalty() -> TangentialMethod {
-    TangentialMethod::Penalty(PenaltySettings {
-        stiffness: 2e5,
-        damping: 10.0,
-    })
-}
-
-fn run(model: &Model, case: &Case, method: TangentialMethod) -> RunResults {
-    let settings = RunSettings {
-        method,
-        stick_velocity: StickVelocity::HalfStep,
-        output_every: 1,
-        statistics: Default::default(),
-        ..case.settings.clone()
-    };
-    simulate(model, &settings).expect("valid run")
-}
-
-fn max_abs(v: impl Iterator<Item = f64>) -> f64 {
-    v.fold(0.0, |m, x| m.max(x.abs()))
 }
 
 #[test]
