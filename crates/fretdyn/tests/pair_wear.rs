@@ -53,8 +53,8 @@ fn pair_of(case: &Case, model: &mut Model, a: usize, b: usize) {
         &model.basis.points,
         [0.0, 0.0],
         c.obstacle.clone(),
-        c.normal.clone(),
-        c.friction.clone(),
+        c.normal,
+        c.friction,
     )
     .unwrap();
     pair.motion = c.motion.clone();
