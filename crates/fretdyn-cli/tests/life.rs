@@ -97,10 +97,9 @@ fn a_life_writes_its_depths_against_time_and_converges_under_halvings() {
     assert_eq!(json["results"]["end"]["status"], "completed");
     assert!(json["results"]["time_to_criterion"][0].as_f64().unwrap() > 0.0);
     let scars = std::fs::read_to_string(s.0.join("out/scars.csv")).unwrap();
-    assert!(
-        scars
-            .starts_with("contact,kind,bin,angle_deg,clearance_increase,tube_depth\nbar,plane,0,,")
-    );
+    assert!(scars.starts_with(
+        "contact,kind,bin,angle_deg,clearance_increase,tube_depth,support_depth\nbar,plane,0,,"
+    ));
     assert!(std::fs::metadata(s.0.join("out/life.png")).unwrap().len() > 10_000);
     let conv = std::fs::read_to_string(s.0.join("out/convergence.csv")).unwrap();
     assert_eq!(conv.lines().count(), 3, "{conv}");

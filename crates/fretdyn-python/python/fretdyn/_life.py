@@ -148,7 +148,8 @@ class LifeResult:
     scars : pandas.DataFrame
         The final scar profiles, the rows of ``scars.csv``: ``contact``, ``kind`` (plane,
         bars, hole), ``bin``, ``angle_deg`` (a hole's bins; NaN otherwise),
-        ``clearance_increase``, ``tube_depth`` (m).
+        ``clearance_increase``, ``tube_depth``, ``support_depth`` (m; bodies A and B of a
+        two-body contact).
     convergence : pandas.DataFrame or None
         With ``halvings``: the rows of ``convergence.csv`` (``max_depth_change``,
         ``life_steps``, ``life_end``, ``end_years``, ``<contact>.tube_depth``), the life
@@ -246,11 +247,12 @@ class LifeResult:
         rows = []
         for s in self._results["scars"]:
             n = len(s["clearance_increase"])
-            for b, (a, t) in enumerate(zip(s["clearance_increase"], s["tube_depth"])):
+            depths = zip(s["clearance_increase"], s["tube_depth"], s["support_depth"])
+            for b, (a, t, sd) in enumerate(depths):
                 angle = (b + 0.5) * 360.0 / n if s["kind"] == "hole" else np.nan
-                rows.append((s["contact"], s["kind"], b, angle, a, t))
+                rows.append((s["contact"], s["kind"], b, angle, a, t, sd))
         return pd.DataFrame(rows, columns=["contact", "kind", "bin", "angle_deg",
-                                           "clearance_increase", "tube_depth"])
+                                           "clearance_increase", "tube_depth", "support_depth"])
 
     def _convergence(self, lives: list):
         pd = _pandas()

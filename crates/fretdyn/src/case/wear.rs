@@ -72,7 +72,9 @@ enum ScarInput {
         tube_radius: Option<f64>,
     },
     Tube {
-        other_radius: f64,
+        /// Required for a contact with an obstacle; a two-body contact's defaults to the
+        /// radius of its side B.
+        other_radius: Option<f64>,
         crossing_deg: f64,
         length: Option<f64>,
         tube_radius: Option<f64>,
@@ -112,6 +114,35 @@ impl WearInput {
         obstacle: &ObstacleInput,
         field: &str,
     ) -> Result<ContactWear> {
+        self.build_for(radius, None, obstacle, field)
+    }
+
+    /// The wear of a two-body contact (THEORY §15, [`ContactWear`]): `tube` is the law of
+    /// body A (the contact's point), `support` the law of body B (its other point), the scar
+    /// A's against B; `radii = [R_A, R_B]` are the pair's surface radii (0 if absent), the
+    /// tube's radius `R_A` (or `scar.tube_radius`) and, for a `tube` scar, the other tube's
+    /// `R_B` (or `scar.other_radius`; both given must agree); `obstacle` the pair's relative
+    /// obstacle, `field` the contact. A tube against a flat bar has the tube as body A.
+    // for the two-body contacts of the `[[structures]]` case builder (issue 3.4)
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(super) fn build_pair(
+        &self,
+        radii: [f64; 2],
+        obstacle: &ObstacleInput,
+        field: &str,
+    ) -> Result<ContactWear> {
+        self.build_for(radii[0], Some(radii[1]), obstacle, field)
+    }
+
+    /// [`Self::build`] with `other`, side B's radius of a two-body contact (`None` for a
+    /// contact with an obstacle).
+    fn build_for(
+        &self,
+        radius: f64,
+        other: Option<f64>,
+        obstacle: &ObstacleInput,
+        field: &str,
+    ) -> Result<ContactWear> {
         let field = format!("{field}.wear");
         let sf = format!("{field}.scar");
         let (kind, written) = match self.scar {
@@ -147,6 +178,7 @@ impl WearInput {
                 ),
             ));
         }
+        let side_a = if other.is_some() { " of side A" } else { "" };
         let tube_radius = match (radius > 0.0, written) {
             (true, None) => radius,
             (true, Some(r)) if r == radius => radius,
@@ -154,7 +186,7 @@ impl WearInput {
                 return Err(Error::invalid(
                     format!("{sf}.tube_radius"),
                     format!(
-                        "{} m differs from the contact's radius {} m: give the tube's outer radius once",
+                        "{} m differs from the contact's radius{side_a} {} m: give the tube's outer radius once",
                         number(r),
                         number(radius)
                     ),
@@ -164,7 +196,9 @@ impl WearInput {
             (false, None) => {
                 return Err(Error::invalid(
                     format!("{sf}.tube_radius"),
-                    "the scar needs the tube's outer radius: give the contact's radius (m) or scar.tube_radius",
+                    format!(
+                        "the scar needs the tube's outer radius: give the contact's radius{side_a} (m) or scar.tube_radius"
+                    ),
                 ));
             }
         };
@@ -210,7 +244,32 @@ impl WearInput {
                 ..
             } => Scar::Tube {
                 tube_radius,
-                other_radius,
+                other_radius: match (other.filter(|r| *r > 0.0), other_radius) {
+                    (None, Some(r)) => r,
+                    (Some(b), None) => b,
+                    (Some(b), Some(r)) if r == b => b,
+                    (Some(b), Some(r)) => {
+                        return Err(Error::invalid(
+                            format!("{sf}.other_radius"),
+                            format!(
+                                "{} m differs from the contact's radius of side B {} m: give the other tube's outer radius once",
+                                number(r),
+                                number(b)
+                            ),
+                        ));
+                    }
+                    (None, None) => {
+                        let how = if other.is_some() {
+                            "the contact's radius of side B (m) or scar.other_radius"
+                        } else {
+                            "scar.other_radius (m)"
+                        };
+                        return Err(Error::invalid(
+                            format!("{sf}.other_radius"),
+                            format!("the scar needs the other tube's outer radius: give {how}"),
+                        ));
+                    }
+                },
                 crossing: crossing_deg.to_radians(),
                 length,
             },
@@ -236,5 +295,55 @@ fn obstacle_name(o: &ObstacleInput) -> &'static str {
         ObstacleInput::BiPlane { .. } => "bi_plane",
         ObstacleInput::Polygon { .. } => "polygon",
         ObstacleInput::Cylinder { .. } => "cylinder",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wear(scar: &str) -> WearInput {
+        toml::from_str(&format!(
+            "tube = {{ law = \"archard\", coefficient = 2e-15 }}\nsupport = {{ law = \"archard\", coefficient = 1e-15 }}\nscar = {scar}\n"
+        ))
+        .unwrap()
+    }
+
+    fn plane() -> ObstacleInput {
+        toml::from_str("type = \"plane\"\nnormal = [0.0, 0.0, 1.0]\n").unwrap()
+    }
+
+    /// A two-body contact's tube scar takes side A's radius as the tube's and side B's as
+    /// the other tube's; given twice they must agree; a contact with an obstacle must give
+    /// the other tube's radius.
+    #[test]
+    fn a_pair_s_tube_scar_takes_the_radii_of_its_two_sides() {
+        let tube = wear("{ type = \"tube\", crossing_deg = 90.0 }");
+        let w = tube.build_pair([0.01, 0.008], &plane(), "c").unwrap();
+        assert_eq!(
+            w.scar,
+            Scar::Tube {
+                tube_radius: 0.01,
+                other_radius: 0.008,
+                crossing: std::f64::consts::FRAC_PI_2,
+                length: None
+            }
+        );
+        assert_eq!(w.tube, WearLaw::Archard { coefficient: 2e-15 });
+        assert_eq!(w.support, WearLaw::Archard { coefficient: 1e-15 });
+        let e = tube.build(0.01, &plane(), "c").unwrap_err();
+        assert_eq!(e.field(), Some("c.wear.scar.other_radius"));
+        let e = tube.build_pair([0.01, 0.0], &plane(), "c").unwrap_err();
+        assert_eq!(e.field(), Some("c.wear.scar.other_radius"));
+        assert!(e.to_string().contains("side B"), "{e}");
+        let both = wear("{ type = \"tube\", crossing_deg = 90.0, other_radius = 0.009 }");
+        let e = both.build_pair([0.01, 0.008], &plane(), "c").unwrap_err();
+        assert_eq!(e.field(), Some("c.wear.scar.other_radius"));
+        let w = both.build_pair([0.01, 0.0], &plane(), "c").unwrap();
+        assert!(matches!(w.scar, Scar::Tube { other_radius, .. } if other_radius == 0.009));
+        // a bar: side A is the tube
+        let bar = wear("{ type = \"flat_bar\", width = 0.02 }");
+        let w = bar.build_pair([0.01, 0.003], &plane(), "c").unwrap();
+        assert_eq!(w.scar.tube_radius(), 0.01);
     }
 }

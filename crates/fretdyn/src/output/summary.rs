@@ -101,7 +101,8 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
 
 /// The per-contact statistics; a contact with `wear` (docs/WEAR.md) also gets
 /// `tube_volume_rate` and `support_volume_rate`, m³/s, its laws at the run's wear work rate
-/// (friction or normal, as its `work` says) and service time 0 (THEORY §14).
+/// (friction or normal, as its `work` says) and service time 0 (THEORY §14); a two-body
+/// contact also `tube_body` and `support_body`, the names of its points A and B.
 fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
     let mut contacts = json!(results.contacts);
     if let Some(list) = contacts.as_array_mut() {
@@ -110,6 +111,12 @@ fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_j
                 let (tube, support) = w.volume_rates(w.work.rate(stats), 0.0);
                 map.insert("tube_volume_rate".into(), json!(tube));
                 map.insert("support_volume_rate".into(), json!(support));
+                // a two-body contact: whose wear the two rates are (points A and B)
+                let contact = &case.model.contacts[k];
+                if let Some([a, b]) = crate::wear::pair_bodies(contact, &case.model.basis.points) {
+                    map.insert("tube_body".into(), json!(a));
+                    map.insert("support_body".into(), json!(b));
+                }
             }
         }
     }

@@ -24,17 +24,40 @@ pub mod scar;
 pub use law::WearLaw;
 pub use scar::{HoleScar, Scar};
 
+use crate::contact::Contact;
 use crate::error::Result;
+use crate::structure::modal::Point;
+
+/// The bodies whose wear the `tube` and the `support` laws of a two-body contact give: the
+/// names of its point A and of its point B in `points` (the model's basis). `None` for a
+/// contact with an obstacle (the support is then its obstacle).
+pub fn pair_bodies<'a>(contact: &Contact, points: &'a [Point]) -> Option<[&'a str; 2]> {
+    let b = contact.other()?;
+    Some([
+        points.get(contact.point)?.name.as_str(),
+        points.get(b)?.name.as_str(),
+    ])
+}
 
 /// The wear of one contact: the law of each body and the geometry of their scars
 /// (`docs/THEORY.md §14`). The tube and the support each wear by their own law from the same
 /// wear work rate (Code_Aster's `MOBILE` and `OBSTACLE` coefficients), and each scar is the
 /// imprint of the other body.
+///
+/// **Two-body contacts** ([`crate::contact::Pair`]): the "tube" is body A (the contact's
+/// point) and the "support" is body B (the pair's other point); the friction work `W` done
+/// at their interface wears both, `V_A = f_A(W, t)` and `V_B = f_B(W, t)` by their own laws
+/// (Archard: `V_A = K_A W t`, `V_B = K_B W t`). The scar is A's against B: [`Scar::Tube`]
+/// for tube against tube (`tube_radius = R_A`, `other_radius = R_B`: both scars are the
+/// overlap of the two cylinders), [`Scar::FlatBar`] for a tube A against a bar B (a flat cut
+/// on the tube, a groove in the bar). In a service life both scars grow and the pair's
+/// relative obstacle recedes by their approach, as a rigid obstacle's does (THEORY §14.4);
+/// [`pair_bodies`] names the two bodies in the outputs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactWear {
-    /// The tube's wear law.
+    /// The tube's wear law (body A of a two-body contact).
     pub tube: WearLaw,
-    /// The support's (obstacle's) wear law.
+    /// The support's (obstacle's) wear law (body B of a two-body contact).
     pub support: WearLaw,
     /// The scar geometry.
     pub scar: Scar,

@@ -164,18 +164,25 @@ pub fn life_csv(r: &LifeResults) -> String {
 }
 
 /// The text of `scars.csv`: one row per bin of every final scar profile (`angle_deg`, the
-/// centre of the bin, for a hole only).
+/// centre of the bin, for a hole only), the tube's and the support's depth (bodies A and B of
+/// a two-body contact).
 pub fn scars_csv(r: &LifeResults) -> String {
-    let mut scars = String::from("contact,kind,bin,angle_deg,clearance_increase,tube_depth\n");
+    let mut scars =
+        String::from("contact,kind,bin,angle_deg,clearance_increase,tube_depth,support_depth\n");
     for s in &r.scars {
         let n = s.clearance_increase.len();
-        for (b, (a, t)) in s.clearance_increase.iter().zip(&s.tube_depth).enumerate() {
+        let depths = s.tube_depth.iter().zip(&s.support_depth);
+        for (b, (a, (t, sd))) in s.clearance_increase.iter().zip(depths).enumerate() {
             let angle = if s.kind == "hole" {
                 format!("{}", (b as f64 + 0.5) * 360.0 / n as f64)
             } else {
                 String::new()
             };
-            let _ = writeln!(scars, "{},{},{b},{angle},{a:e},{t:e}", s.contact, s.kind);
+            let _ = writeln!(
+                scars,
+                "{},{},{b},{angle},{a:e},{t:e},{sd:e}",
+                s.contact, s.kind
+            );
         }
     }
     scars

@@ -42,4 +42,4 @@ pub use files::{
 pub use results::{
     ContactLife, LifeEnd, LifeResults, LifeStep, ScarProfile, depth_standard_errors,
 };
-pub use service::{MAX_HALVINGS, check_life, service_life, service_life_with};
+pub use service::{MAX_HALVINGS, check_life, service_life, service_life_with, worn_model};

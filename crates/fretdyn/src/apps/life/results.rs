@@ -127,6 +127,8 @@ pub struct ScarProfile {
     pub clearance_increase: Vec<f64>,
     /// Tube depth per bin, m.
     pub tube_depth: Vec<f64>,
+    /// Support depth per bin (body B's scar of a two-body contact), m.
+    pub support_depth: Vec<f64>,
 }
 
 /// The result of [`service_life`](super::service_life).
@@ -136,6 +138,12 @@ pub struct LifeResults {
     pub contacts: Vec<String>,
     /// Clearance at rest of each wearing contact, m.
     pub clearances: Vec<f64>,
+    /// For each wearing contact between two bodies (THEORY §15), the names of the points
+    /// `[A, B]` whose bodies its `tube_*` and `support_*` values are of
+    /// ([`pair_bodies`](crate::wear::pair_bodies)); `None` for a contact with an obstacle (its
+    /// support is the obstacle). In `life.json` only when a contact is between two bodies.
+    #[serde(skip_serializing_if = "no_pairs")]
+    pub bodies: Vec<Option<[String; 2]>>,
     /// The state at t = 0 and after every life step.
     pub steps: Vec<LifeStep>,
     /// Time at which each contact's tube depth reaches the criterion, s (`None`: not reached).
@@ -150,6 +158,10 @@ pub struct LifeResults {
     pub windows: usize,
     /// Wall-clock time, s.
     pub wall_time: f64,
+}
+
+fn no_pairs(bodies: &[Option<[String; 2]>]) -> bool {
+    bodies.iter().all(Option::is_none)
 }
 
 /// The first-order standard error of one contact's tube depth after each life step, with the

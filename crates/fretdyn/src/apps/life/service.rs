@@ -15,6 +15,48 @@ use crate::case::Case;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::settings::life::LifeSettings;
+use crate::wear::pair_bodies;
+
+/// Contact `k` of `current` on its unworn obstacle in `model` worn by the clearance `added`
+/// per bin of its wear map (THEORY §14.4); for a two-body contact the obstacle is the pair's
+/// relative one, which recedes by the approach of both bodies' scars.
+fn wear_obstacle(
+    current: &mut Model,
+    model: &Model,
+    k: usize,
+    added: &[f64],
+    field: &str,
+) -> Result<()> {
+    current.contacts[k].obstacle = model.contacts[k]
+        .obstacle
+        .worn(&obstacle_wear(added), field)?;
+    Ok(())
+}
+
+/// `model` with the scars at the end of the life `results` (of this model) fed back: each
+/// wearing contact's obstacle worn by its final scar profile's `clearance_increase`
+/// (THEORY §14.4) — the model the life's next window would simulate (with feedback).
+pub fn worn_model(model: &Model, results: &LifeResults) -> Result<Model> {
+    let mut worn = model.clone();
+    for scar in &results.scars {
+        let k = model
+            .contacts
+            .iter()
+            .position(|c| c.name == scar.contact)
+            .ok_or_else(|| {
+                Error::invalid(
+                    "life",
+                    format!(
+                        "the life's contact '{}' is not in the model: give the model the life was computed on",
+                        scar.contact
+                    ),
+                )
+            })?;
+        let field = format!("contacts[{k}].wear");
+        wear_obstacle(&mut worn, model, k, &scar.clearance_increase, &field)?;
+    }
+    Ok(worn)
+}
 
 /// The service life of `case` with its `[life]` settings (THEORY §14.5). `observer` sees
 /// each step as it is done.
@@ -122,9 +164,7 @@ pub fn service_life_with(
         c.restore(s);
         if life.feedback && state.steps.len() > 1 {
             let added = c.worn.depths(c.wear, &c.field)?.added;
-            current.contacts[c.k].obstacle = model.contacts[c.k]
-                .obstacle
-                .worn(&obstacle_wear(&added), &c.field)?;
+            wear_obstacle(&mut current, model, c.k, &added, &c.field)?;
         }
     }
     let mut last_checkpoint = Instant::now();
@@ -306,9 +346,7 @@ pub fn service_life_with(
                 tube_depth_fixed_gap: tube_fixed,
             });
             if life.feedback {
-                current.contacts[c.k].obstacle = model.contacts[c.k]
-                    .obstacle
-                    .worn(&obstacle_wear(&a.depths.added), &c.field)?;
+                wear_obstacle(&mut current, model, c.k, &a.depths.added, &c.field)?;
             }
             (c.worn, c.fixed) = (a.worn, f.worn);
         }
@@ -346,11 +384,19 @@ pub fn service_life_with(
             },
             clearance_increase: d.added,
             tube_depth: d.tube,
+            support_depth: d.support,
         });
     }
     Ok(LifeResults {
         contacts: tracks.iter().map(|c| c.name.clone()).collect(),
         clearances: tracks.iter().map(|c| c.clearance).collect(),
+        bodies: tracks
+            .iter()
+            .map(|c| {
+                pair_bodies(&model.contacts[c.k], &model.basis.points)
+                    .map(|b| b.map(str::to_string))
+            })
+            .collect(),
         steps: state.steps,
         time_to_criterion: tracks.iter().map(|c| c.criterion).collect(),
         time_to_criterion_fixed_gap: tracks.iter().map(|c| c.criterion_fixed).collect(),

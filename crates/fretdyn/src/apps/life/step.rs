@@ -22,6 +22,8 @@ pub(super) struct Worn {
 pub(super) struct Depths {
     /// Tube depth per bin (what faces each direction), m.
     pub(super) tube: Vec<f64>,
+    /// Support depth per bin (body B's of a two-body contact), m.
+    pub(super) support: Vec<f64>,
     /// Added clearance per bin, m.
     pub(super) added: Vec<f64>,
     /// Support depth where deepest, m.
@@ -45,6 +47,7 @@ impl Worn {
         if n <= 2 {
             let mut d = Depths {
                 tube: vec![0.0; n],
+                support: vec![0.0; n],
                 added: vec![0.0; n],
                 support_max: 0.0,
             };
@@ -53,6 +56,7 @@ impl Worn {
                 let t = wear.scar.tube_depth(vt).map_err(|e| at(e, field))?;
                 let s = wear.scar.support_depth(vs).map_err(|e| at(e, field))?;
                 d.tube[b] = t;
+                d.support[b] = s;
                 d.added[b] = wear.scar.approach(vt, vs).map_err(|e| at(e, field))?;
                 d.support_max = d.support_max.max(s);
             }
@@ -89,6 +93,7 @@ impl Worn {
         };
         Ok(Depths {
             tube: shape.iter().map(|f| f * t).collect(),
+            support: shape.iter().map(|f| f * s).collect(),
             added: shape.iter().map(|f| f * approach).collect(),
             support_max: s,
         })

@@ -41,7 +41,8 @@ pub(super) struct Advanced {
 impl<'a> Track<'a> {
     pub(super) fn new(model: &'a Model, k: usize, bins: usize) -> Self {
         let c = &model.contacts[k];
-        let x = model.basis.points[c.point].coords;
+        // the point the contact sees: the relative point A − B of a two-body contact
+        let x = c.point_in(&model.basis.points).coords;
         let worn = Worn::new(WearMap::new(model, bins).work(k).len());
         Self {
             k,
