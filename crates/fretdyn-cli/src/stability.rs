@@ -17,6 +17,12 @@ pub fn main(path: &Path, output: Option<PathBuf>) -> Result<(), Failure> {
         errln!("warning: {w}");
     }
     let Some(report) = case.stability() else {
+        if !case.model.structures.is_empty() {
+            return Err(Failure::input(format!(
+                "{}: structures: the Connors check of a case of several structures is not supported yet: check each structure in a case of its own ([structure] with its [flow])",
+                path.display()
+            )));
+        }
         return Err(Failure::input(format!(
             "{}: flow: the case has no [flow] section: add one with its [[flow.zones]] (docs/FLOW.md)",
             path.display()

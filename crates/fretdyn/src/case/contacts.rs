@@ -1,5 +1,6 @@
-//! `[[contacts]]`: obstacles (plane, bi-plane, circle, polygon), their motion, the normal
-//! law and the friction coefficients (THEORY §3, §4, §7, §8).
+//! `[[contacts]]`: obstacles (plane, bi-plane, circle, polygon, cylinder), their motion, the
+//! normal law and the friction coefficients (THEORY §3, §4, §7, §8); with `other`, a
+//! two-body contact between two points (THEORY §15).
 
 use nalgebra::{Vector2, Vector3};
 use serde::Deserialize;
@@ -19,9 +20,15 @@ use crate::model::Model;
 pub(super) struct ContactSection {
     name: Option<String>,
     point: String,
+    /// Point B of a two-body contact (THEORY §15): the contact is on the relative point
+    /// `point − other`, its obstacle in relative coordinates.
+    other: Option<String>,
     obstacle: ObstacleInput,
-    #[serde(default)]
-    radius: f64,
+    /// The tube's outer radius around `point` (0: the contact is on the axis).
+    radius: Option<f64>,
+    /// A two-body contact's surface radii `[R_A, R_B]` around `point` and `other`, m
+    /// (default `[0, 0]`).
+    radii: Option<[f64; 2]>,
     motion: Option<MotionInput>,
     normal: NormalInput,
     friction: FrictionInput,
@@ -87,10 +94,12 @@ pub(super) struct FrictionInput {
 }
 
 /// `[[contacts]]`: each contact's point, obstacle (and its motion), normal law and friction
-/// coefficients (THEORY §3, §4, §7, §8).
-pub(super) fn build_contacts(
+/// coefficients (THEORY §3, §4, §7, §8), or, with `other`, the two points of a two-body
+/// contact (THEORY §15). `tube_of` gives the tube structure a point (its index) belongs to,
+/// if it is one: the radii are checked against its outer radius.
+pub(super) fn build_contacts<'t>(
     contacts: &[ContactSection],
-    tube: Option<&TubeModel>,
+    tube_of: &dyn Fn(usize) -> Option<&'t TubeModel>,
     model: &mut Model,
 ) -> Result<()> {
     // the index of each name given so far (a search per contact was O(m²): minutes for
@@ -99,6 +108,23 @@ pub(super) fn build_contacts(
     for (k, c) in contacts.iter().enumerate() {
         let field = format!("contacts[{k}]");
         let pt = point_index(&c.point, format!("{field}.point"), model)?;
+        let pair = match &c.other {
+            None if c.radii.is_some() => {
+                return Err(Error::invalid(
+                    format!("{field}.radii"),
+                    "radii = [R_A, R_B] are the two surfaces of a two-body contact: name its second point with other = \"…\", or give the tube's radius as radius",
+                ));
+            }
+            None => None,
+            Some(other) => Some(two_body(c, pt, other, &field, tube_of, model)?),
+        };
+        // a pair's planes are placed from the rest relative position x0_A − x0_B
+        let at = |origin: [f64; 3]| match &pair {
+            Some((b, _)) => {
+                v3(origin) + model.basis.points[pt].coords - model.basis.points[*b].coords
+            }
+            None => v3(origin),
+        };
         let obstacle = match c.obstacle {
             ObstacleInput::Plane {
                 origin,
@@ -106,7 +132,7 @@ pub(super) fn build_contacts(
                 gap,
                 tangent,
             } => Obstacle::Plane(Plane::new(
-                v3(origin),
+                at(origin),
                 v3(normal),
                 gap,
                 tangent.map(v3),
@@ -128,7 +154,7 @@ pub(super) fn build_contacts(
                 gap,
                 tangent,
             } => Obstacle::BiPlane(BiPlane::new(
-                v3(origin),
+                at(origin),
                 v3(normal),
                 gap,
                 tangent.map(v3),
@@ -168,10 +194,11 @@ pub(super) fn build_contacts(
                 axis,
                 radius,
             } => {
-                let Some(radius) = radius else {
+                let sum = pair.map(|(_, r)| r[0] + r[1]).filter(|r| *r > 0.0);
+                let Some(radius) = radius.or(sum) else {
                     return Err(Error::invalid(
                         format!("{field}.obstacle.radius"),
-                        "a cylinder needs its radius, m (the distance from its axis at which the point touches it)",
+                        "a cylinder needs its radius, m (the distance from its axis at which the point touches it; for two tubes the sum of their outer radii, the default when the contact gives radii = [R_A, R_B])",
                     ));
                 };
                 Obstacle::Cylinder(Cylinder::new(
@@ -223,31 +250,97 @@ pub(super) fn build_contacts(
                 ),
             ));
         }
-        if let (Some(t), true) = (tube, c.radius > 0.0) {
-            let outer = 0.5 * t.structure.beam.tube.section.outer_diameter;
-            if c.radius > outer * (1.0 + 1e-9) {
-                return Err(Error::invalid(
-                    format!("{field}.radius"),
-                    format!(
-                        "{} m is larger than the tube's outer radius {} m (structure.outer_diameter/2): give the outer radius in m",
-                        number(c.radius),
-                        number(outer)
-                    ),
-                ));
-            }
+        let radius = c.radius.unwrap_or(0.0);
+        if radius > 0.0 {
+            check_radius(radius, tube_of(pt), &format!("{field}.radius"))?;
         }
-        let mut contact = Contact::new(name, pt, obstacle, normal, friction);
-        contact.radius = c.radius;
+        let mut contact = match pair {
+            None => {
+                let mut contact = Contact::new(name, pt, obstacle, normal, friction);
+                contact.radius = radius;
+                contact
+            }
+            Some((b, radii)) => Contact::between(
+                name,
+                pt,
+                b,
+                &model.basis.points,
+                radii,
+                obstacle,
+                normal,
+                friction,
+            )
+            .map_err(|e| match e {
+                Error::Invalid { field: f, message } => Error::invalid(
+                    format!("{field}.{}", f.rsplit('.').next().unwrap_or(&f)),
+                    message,
+                ),
+                other => other,
+            })?,
+        };
         if let Some(m) = &c.motion {
             contact.motion = m.motion();
         }
-        contact.validate(&model.basis.points[pt], &field)?;
+        contact.validate(contact.point_in(&model.basis.points), &field)?;
+        // a pair's wear: the scar of side A (its radius R_A)
+        let wear_radius = pair.map_or(radius, |(_, r)| r[0]);
         let wear = c
             .wear
             .as_ref()
-            .map(|w| w.build(c.radius, &c.obstacle, &field));
+            .map(|w| w.build(wear_radius, &c.obstacle, &field));
         model.wear.push(wear.transpose()?);
         model.contacts.push(contact);
+    }
+    Ok(())
+}
+
+/// Point B and the radii `[R_A, R_B]` of the two-body contact `c` (THEORY §15), whose point A
+/// is `a`: `other` names B; `radii` (default `[0, 0]`) replaces `radius`, and the obstacle
+/// moves with B (no `motion`).
+fn two_body<'t>(
+    c: &ContactSection,
+    a: usize,
+    other: &str,
+    field: &str,
+    tube_of: &dyn Fn(usize) -> Option<&'t TubeModel>,
+    model: &Model,
+) -> Result<(usize, [f64; 2])> {
+    let b = point_index(other, format!("{field}.other"), model)?;
+    if c.radius.is_some() {
+        return Err(Error::invalid(
+            format!("{field}.radius"),
+            "a two-body contact (with other) gives its surface radii as radii = [R_A, R_B] (m, around point and other): replace radius",
+        ));
+    }
+    if c.motion.is_some() {
+        return Err(Error::invalid(
+            format!("{field}.motion"),
+            "a two-body contact's obstacle moves with point B (other): remove motion",
+        ));
+    }
+    let radii = c.radii.unwrap_or([0.0; 2]);
+    for (k, (r, p)) in radii.iter().zip([a, b]).enumerate() {
+        if *r > 0.0 {
+            check_radius(*r, tube_of(p), &format!("{field}.radii[{k}]"))?;
+        }
+    }
+    Ok((b, radii))
+}
+
+/// Refuses a surface radius larger than the outer radius of the tube the point is on.
+fn check_radius(radius: f64, tube: Option<&TubeModel>, field: &str) -> Result<()> {
+    if let Some(t) = tube {
+        let outer = 0.5 * t.structure.beam.tube.section.outer_diameter;
+        if radius > outer * (1.0 + 1e-9) {
+            return Err(Error::invalid(
+                field,
+                format!(
+                    "{} m is larger than the tube's outer radius {} m (structure.outer_diameter/2): give the outer radius in m",
+                    number(radius),
+                    number(outer)
+                ),
+            ));
+        }
     }
     Ok(())
 }

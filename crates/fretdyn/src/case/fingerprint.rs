@@ -77,8 +77,9 @@ pub fn canonical(case: &toml::Value) -> String {
     toml::to_string(case).unwrap_or_else(|_| format!("{case:?}"))
 }
 
-/// The file names a case reads, as written in it, in a fixed order: `structure.file`, then
-/// the `file` of every `history` table, depth first in key order.
+/// The file names a case reads, as written in it, in a fixed order: `structure.file` (or each
+/// `structures[i].structure.file`), then the `file` of every `history` table, depth first in
+/// key order.
 pub fn file_names(case: &toml::Value) -> Vec<String> {
     fn histories(v: &toml::Value, out: &mut Vec<String>) {
         match v {
@@ -97,6 +98,14 @@ pub fn file_names(case: &toml::Value) -> Vec<String> {
     let mut out = Vec::new();
     if let Some(toml::Value::String(f)) = case.get("structure").and_then(|s| s.get("file")) {
         out.push(f.clone());
+    }
+    if let Some(toml::Value::Array(structures)) = case.get("structures") {
+        for entry in structures {
+            if let Some(toml::Value::String(f)) = entry.get("structure").and_then(|s| s.get("file"))
+            {
+                out.push(f.clone());
+            }
+        }
     }
     histories(case, &mut out);
     out

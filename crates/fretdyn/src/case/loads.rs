@@ -63,7 +63,8 @@ pub(super) struct TurbulenceSection {
     directions: Vec<[f64; 3]>,
     /// Correlation length λ of `exp(−|Δs|/λ)`, m (`inf`: fully correlated).
     correlation_length: f64,
-    seed: u64,
+    /// Default: [`default_seed`] of the structure's index and the entry's.
+    seed: Option<u64>,
     f_max: f64,
     spectrum: SpectrumInput,
     /// Fraction of the correlation matrix's trace that the kept channels may leave out.
@@ -368,6 +369,17 @@ pub(super) struct LoadSections<'a> {
     pub turbulence: &'a [TurbulenceSection],
     pub base_excitation: Option<&'a BaseSection>,
     pub dt: f64,
+    /// The structure's index in the case (0 for a one-structure case): the default seeds.
+    pub structure: usize,
+}
+
+/// The seed of `[[turbulence]]` entry `k` of structure `structure` (0 for a one-structure
+/// case, `i` for `structures[i]`) that gives none: `1000·structure + k`. Entries, and the same
+/// entry of two identical structures, get distinct seeds, hence independent signals (two
+/// neighbouring tubes with one seed would see the same turbulence, fully correlated); an
+/// explicit `seed` is kept as written.
+pub(super) fn default_seed(structure: usize, k: usize) -> u64 {
+    1000 * structure as u64 + k as u64
 }
 
 impl LoadSections<'_> {
@@ -521,7 +533,7 @@ impl LoadSections<'_> {
             let load = TurbulentLoad {
                 spectrum,
                 rows,
-                seed: l.seed,
+                seed: l.seed.unwrap_or(default_seed(self.structure, k)),
                 f_max: l.f_max,
             };
             load.validate(modes, &field)?;

@@ -6,6 +6,8 @@
 //! The schema is split by section, each file holding its sections' types and the build of
 //! the model from them:
 //! - `structure`: `[structure]` and `[initial]`;
+//! - `structures`: `[[structures]]`, several structures each with its own sections, built by
+//!   the code that builds a one-structure case's;
 //! - `contacts`: `[[contacts]]` (their `obstacle` tables in `obstacle`, their `wear` tables
 //!   in `wear`);
 //! - `loads`: `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]`, `[[turbulence]]`,
@@ -33,6 +35,7 @@ mod quantities;
 mod settings;
 mod shared;
 mod structure;
+mod structures;
 mod wear;
 
 pub use shared::TubeModel;
@@ -41,13 +44,12 @@ pub(crate) use shared::named_file;
 use contacts::{ContactSection, build_contacts};
 use flow::FlowSection;
 use life::LifeSection;
-use loads::{
-    BaseSection, LineLoadSection, LoadSection, LoadSections, ModalLoadSection, TurbulenceSection,
-};
+use loads::{BaseSection, LineLoadSection, LoadSection, ModalLoadSection, TurbulenceSection};
 use settings::{
     OutputSection, SettingsSections, StatisticsSection, TangentialSection, TimeSection,
 };
 use structure::{InitialSection, StructureSection};
+use structures::{StructureEntry, StructureParts};
 
 use std::path::Path;
 
@@ -71,15 +73,18 @@ pub struct Case {
     pub echo: serde_json::Value,
     /// Accepted but doubtful input (e.g. an approximately mass-normalised basis).
     pub warnings: Vec<String>,
-    /// For a `type = "tube"` structure: its finite-element model and modes.
+    /// For a `type = "tube"` structure: its finite-element model and modes (`None` for a case
+    /// of several structures).
     pub tube: Option<Box<TubeModel>>,
-    /// The `[flow]` section: flow zones sampled on the modes (docs/FLOW.md).
+    /// The `[flow]` section: flow zones sampled on the modes (docs/FLOW.md); `None` for a case
+    /// of several structures, whose flows act through the model's loads and fluid-elastic
+    /// forces (their Connors check is not made).
     pub flow: Option<Box<Flow>>,
     /// The abscissa `s` along the tube of each point of the basis (same order as
     /// `model.basis.points`), m, where known: a tube's named points (at their node), the
     /// `s_<name>` of a `.npz`, `s = …` of inline points, a pinned beam's stations. The
     /// curvilinear coordinate of the `[[flow.zones]]` (docs/FLOW.md); `fretdyn modes` writes
-    /// them as `s_<name>`.
+    /// them as `s_<name>`. In a case of several structures, each along its own structure.
     pub point_abscissae: Vec<Option<f64>>,
     /// The `[life]` section: the service life (THEORY §14.5), for `fretdyn life`.
     pub life: Option<crate::settings::life::LifeSettings>,
@@ -122,6 +127,12 @@ impl Case {
         let title = file.title.clone().unwrap_or_default();
         let life_section = file.life.take();
         let (model, settings, tube, flow, point_abscissae) = file.build(base, &mut warnings)?;
+        if life_section.is_some() && !model.structures.is_empty() {
+            return Err(Error::invalid(
+                "life",
+                "a service life of several structures is not supported yet: run the [life] of each structure in a case of its own, or remove [life] to run the case",
+            ));
+        }
         let life = match life_section {
             Some(l) => Some(l.build(tube.as_deref())?),
             None => None,
@@ -163,8 +174,8 @@ impl Case {
 
 /// Makes the file names of a case read as TOML (as JSON: [`Case::echo`]) absolute, resolved
 /// from `base` as the case resolves them, so that the case reads the same files from any
-/// folder. The keys whose values are file names are `structure.file` (a `.npz` modal basis)
-/// and the `file` of every `history` table (a tabulated load history, `.csv` or `.npy`, of
+/// folder. The keys whose values are file names are `structure.file` (a `.npz` modal basis;
+/// `structures[i].structure.file` in a case of several) and the `file` of every `history` table (a tabulated load history, `.csv` or `.npy`, of
 /// `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]` and `[base_excitation]`); a new key
 /// naming a file is added here.
 pub fn absolute_file_names(case: &mut serde_json::Value, base: &Path) {
@@ -189,6 +200,13 @@ pub fn absolute_file_names(case: &mut serde_json::Value, base: &Path) {
     }
     if let Some(file) = case.get_mut("structure").and_then(|s| s.get_mut("file")) {
         absolute(file, base);
+    }
+    if let Some(serde_json::Value::Array(structures)) = case.get_mut("structures") {
+        for entry in structures {
+            if let Some(file) = entry.get_mut("structure").and_then(|s| s.get_mut("file")) {
+                absolute(file, base);
+            }
+        }
     }
     histories(case, base);
 }
@@ -241,7 +259,11 @@ pub(crate) fn parse_error(text: &str, e: &toml::de::Error) -> Error {
 struct CaseFile {
     title: Option<String>,
     time: TimeSection,
-    structure: StructureSection,
+    /// One structure: `[structure]` with its sections at the top level; or several:
+    /// `[[structures]]`, each with its own (never both).
+    structure: Option<StructureSection>,
+    #[serde(default)]
+    structures: Vec<StructureEntry>,
     initial: Option<InitialSection>,
     #[serde(default)]
     contacts: Vec<ContactSection>,
@@ -278,36 +300,46 @@ impl CaseFile {
     /// The model and settings, section by section in the order of the file's schema; the
     /// first invalid value is the error.
     fn build(self, base: &Path, warnings: &mut Vec<String>) -> Result<Built> {
-        let (basis, tube, abscissae) = self.structure.build(base, warnings)?;
-        basis.validate("structure")?;
-        let mut model = Model::new(basis);
-        build_contacts(&self.contacts, tube.as_deref(), &mut model)?;
-        let flow = match &self.flow {
-            Some(f) => Some(Box::new(f.build(tube.as_deref(), &abscissae, &model)?)),
-            None => None,
+        let (model, tube, flow, point_abscissae) = match (
+            &self.structure,
+            self.structures.is_empty(),
+        ) {
+            (Some(structure), true) => {
+                let one = StructureParts {
+                    structure,
+                    initial: self.initial.as_ref(),
+                    contacts: &self.contacts,
+                    loads: &self.loads,
+                    line_loads: &self.line_loads,
+                    modal_loads: &self.modal_loads,
+                    turbulence: &self.turbulence,
+                    flow: self.flow.as_ref(),
+                    index: 0,
+                };
+                let (model, tube, flow, abscissae) =
+                    one.build(base, self.base_excitation.as_ref(), self.time.dt, warnings)?;
+                model.validate()?;
+                let mut point_abscissae = abscissae.s;
+                point_abscissae.resize(model.basis.points.len(), None);
+                (model, tube, flow, point_abscissae)
+            }
+            (None, false) => {
+                let (model, abscissae) = self.build_several(base, warnings)?;
+                (model, None, None, abscissae)
+            }
+            (Some(_), false) => {
+                return Err(Error::invalid(
+                    "structures",
+                    "give either [structure] (one structure) or [[structures]] (several, each named), not both",
+                ));
+            }
+            (None, true) => {
+                return Err(Error::invalid(
+                    "structure",
+                    "missing: give [structure] (one structure), or [[structures]] (several, each with a name and its [structures.structure])",
+                ));
+            }
         };
-        let loads = LoadSections {
-            loads: &self.loads,
-            modal_loads: &self.modal_loads,
-            line_loads: &self.line_loads,
-            turbulence: &self.turbulence,
-            base_excitation: self.base_excitation.as_ref(),
-            dt: self.time.dt,
-        };
-        loads.build(base, tube.as_deref(), flow.as_deref(), &mut model)?;
-        if let Some(f) = &flow {
-            let hz: Vec<f64> = model
-                .basis
-                .omega
-                .iter()
-                .map(|w| w / std::f64::consts::TAU)
-                .collect();
-            model.fluid_elastic = f.fluid_elastic(&hz);
-        }
-        if let Some(initial) = &self.initial {
-            initial.build(&mut model)?;
-        }
-        model.validate()?;
         let sections = SettingsSections {
             time: &self.time,
             tangential: &self.tangential,
@@ -315,8 +347,67 @@ impl CaseFile {
             statistics: &self.statistics,
         };
         let settings = sections.settings(&model)?;
-        let mut point_abscissae = abscissae.s;
-        point_abscissae.resize(model.basis.points.len(), None);
         Ok((model, settings, tube, flow, point_abscissae))
+    }
+
+    /// The model of several structures (THEORY §15): each `[[structures]]` entry built as a
+    /// one-structure case builds its structure, then their union, then the top-level
+    /// `[[contacts]]` between them (points named `structure.point`); and the abscissae of the
+    /// points, each along its own structure.
+    fn build_several(
+        &self,
+        base: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<(Model, Vec<Option<f64>>)> {
+        for (key, given) in [
+            ("initial", self.initial.is_some()),
+            ("loads", !self.loads.is_empty()),
+            ("line_loads", !self.line_loads.is_empty()),
+            ("modal_loads", !self.modal_loads.is_empty()),
+            ("turbulence", !self.turbulence.is_empty()),
+            ("flow", self.flow.is_some()),
+        ] {
+            if given {
+                return Err(Error::invalid(
+                    key,
+                    format!(
+                        "a case of several structures gives its {key} per structure: move it into the [[structures]] entry it acts on ([structures.{key}])"
+                    ),
+                ));
+            }
+        }
+        let mut parts = Vec::with_capacity(self.structures.len());
+        let mut point_abscissae = Vec::new();
+        for (i, s) in self.structures.iter().enumerate() {
+            let field = format!("structures[{i}]");
+            let (model, tube, _, mut abscissae) = s
+                .parts(i)
+                .build(base, self.base_excitation.as_ref(), self.time.dt, warnings)
+                .map_err(|e| e.within(&field))?;
+            abscissae.s.resize(model.basis.points.len(), None);
+            point_abscissae.extend(abscissae.s);
+            parts.push((s.name.clone(), model, tube));
+        }
+        let tubes: Vec<(std::ops::Range<usize>, Option<Box<TubeModel>>)> = {
+            let mut first = 0;
+            parts
+                .iter_mut()
+                .map(|(_, m, t)| {
+                    let n = m.basis.points.len();
+                    first += n;
+                    (first - n..first, t.take())
+                })
+                .collect()
+        };
+        let mut model = Model::union(parts.into_iter().map(|(n, m, _)| (n, m)).collect())?;
+        let tube_of = |point: usize| {
+            tubes
+                .iter()
+                .find(|(r, _)| r.contains(&point))
+                .and_then(|(_, t)| t.as_deref())
+        };
+        build_contacts(&self.contacts, &tube_of, &mut model)?;
+        model.validate()?;
+        Ok((model, point_abscissae))
     }
 }

@@ -336,7 +336,7 @@ pub(super) const QUANTITIES: &[Quantity] = &[
     real(&["initial.velocity[*]"], "a velocity", "m/s", -100.0, 100.0),
     // [[contacts]]
     real(
-        &["contacts[*].radius"],
+        &["contacts[*].radius", "contacts[*].radii[*]"],
         "a tube's outer radius",
         "m",
         0.0,
@@ -743,8 +743,15 @@ fn matches(pattern: &str, key: &str) -> bool {
     }
 }
 
-/// The quantity of the key path `key`, if the table has it.
+/// The quantity of the key path `key`, if the table has it. A key of a `[[structures]]`
+/// entry (`structures[1].structure.density`) is the key of the same section of a
+/// one-structure case (`structure.density`).
 pub(super) fn quantity(key: &str) -> Option<&'static Quantity> {
+    let key = key
+        .strip_prefix("structures[")
+        .and_then(|rest| rest.split_once("]."))
+        .filter(|(index, _)| index.bytes().all(|c| c.is_ascii_digit()))
+        .map_or(key, |(_, rest)| rest);
     QUANTITIES
         .iter()
         .find(|q| q.keys.iter().any(|p| matches(p, key)))
@@ -878,6 +885,14 @@ mod tests {
             "structure.damping_ratio",
             "structure.damping_ratio[2]"
         ));
+        // a [[structures]] entry's keys are those of a one-structure case
+        let density = quantity("structure.density").map(|q| q.what);
+        assert_eq!(
+            quantity("structures[3].structure.density").map(|q| q.what),
+            density
+        );
+        assert!(quantity("structures[x].structure.density").is_none());
+        assert!(quantity("structures[0].name").is_none());
     }
 
     /// Every pattern is well formed, listed once, and its ranges ordered.

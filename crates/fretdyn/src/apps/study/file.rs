@@ -198,7 +198,9 @@ impl Study {
         base_case: Option<(toml::Value, PathBuf)>,
     ) -> Result<Self> {
         let value: toml::Value = toml::from_str(text).map_err(|e| parse_error(text, &e))?;
-        if value.get("base").is_none() && value.get("structure").is_some() {
+        if value.get("base").is_none()
+            && (value.get("structure").is_some() || value.get("structures").is_some())
+        {
             return Err(Error::invalid(
                 "base",
                 "this is a case file, not a study file (base = \"case.toml\" and [[parameters]]): run it with `fretdyn run <file>`",
@@ -403,20 +405,35 @@ impl Study {
     }
 
     /// Names of the base case's contacts, as the case gives them (`contact<k>` when unnamed),
-    /// read from the TOML: the header needs no model built.
+    /// read from the TOML: the header needs no model built. In a case of several structures,
+    /// each structure's own first (`tube_a.plate1`), then the top-level ones, as the model
+    /// orders them ([`crate::model::Model::union`]).
     pub fn contact_names(&self) -> Vec<String> {
-        match self.base.get("contacts") {
-            Some(toml::Value::Array(contacts)) => contacts
-                .iter()
-                .enumerate()
-                .map(|(k, c)| {
-                    c.get("name")
-                        .and_then(|n| n.as_str())
-                        .map_or_else(|| format!("contact{k}"), String::from)
-                })
-                .collect(),
-            _ => Vec::new(),
+        fn names(contacts: Option<&toml::Value>, prefix: &str) -> Vec<String> {
+            match contacts {
+                Some(toml::Value::Array(contacts)) => contacts
+                    .iter()
+                    .enumerate()
+                    .map(|(k, c)| {
+                        let name = c
+                            .get("name")
+                            .and_then(|n| n.as_str())
+                            .map_or_else(|| format!("contact{k}"), String::from);
+                        format!("{prefix}{name}")
+                    })
+                    .collect(),
+                _ => Vec::new(),
+            }
         }
+        let mut out = Vec::new();
+        if let Some(toml::Value::Array(structures)) = self.base.get("structures") {
+            for s in structures {
+                let name = s.get("name").and_then(|n| n.as_str()).unwrap_or_default();
+                out.extend(names(s.get("contacts"), &format!("{name}.")));
+            }
+        }
+        out.extend(names(self.base.get("contacts"), ""));
+        out
     }
 
     /// Header of the table: run, each parameter column ([`Self::columns`]), `sample` (in a

@@ -115,12 +115,13 @@ impl Study {
             set_path(&mut value, &c.key, v)
                 .map_err(|e| Error::invalid(c.key.clone(), e.to_string()))?;
         }
-        if let Some(seed) = run.seed
-            && let Some(toml::Value::Array(loads)) = value.get_mut("turbulence")
-        {
-            for l in loads {
-                if let Some(t) = l.as_table_mut() {
-                    t.insert("seed".into(), toml::Value::Integer(seed as i64));
+        if let Some(seed) = run.seed {
+            set_seeds(value.get_mut("turbulence"), seed);
+            // each structure of several its own seeds (independent turbulence), as the case's
+            // default seeds are (`case::loads::default_seed`)
+            if let Some(toml::Value::Array(structures)) = value.get_mut("structures") {
+                for (i, s) in structures.iter_mut().enumerate() {
+                    set_seeds(s.get_mut("turbulence"), seed.wrapping_add(1000 * i as u64));
                 }
             }
         }
@@ -282,4 +283,15 @@ fn life_row(
 /// [`crate::integrator::simulation::simulate`] (running sums, which do not depend on what is recorded).
 pub fn run_statistics(case: &Case) -> Result<RunResults> {
     statistics_run(&case.model, &case.settings, None).map(|(results, _)| results)
+}
+
+/// Sets `seed` in every `[[turbulence]]` entry of `loads`.
+fn set_seeds(loads: Option<&mut toml::Value>, seed: u64) {
+    if let Some(toml::Value::Array(loads)) = loads {
+        for l in loads {
+            if let Some(t) = l.as_table_mut() {
+                t.insert("seed".into(), toml::Value::Integer(seed as i64));
+            }
+        }
+    }
 }
