@@ -282,12 +282,11 @@ pub(super) fn build_contacts<'t>(
             contact.motion = m.motion();
         }
         contact.validate(contact.point_in(&model.basis.points), &field)?;
-        // a pair's wear: the scar of side A (its radius R_A)
-        let wear_radius = pair.map_or(radius, |(_, r)| r[0]);
-        let wear = c
-            .wear
-            .as_ref()
-            .map(|w| w.build(wear_radius, &c.obstacle, &field));
+        // a pair's wear: A's scar against B, each side's radius (THEORY §15)
+        let wear = c.wear.as_ref().map(|w| match pair {
+            Some((_, radii)) => w.build_pair(radii, &c.obstacle, &field),
+            None => w.build(radius, &c.obstacle, &field),
+        });
         model.wear.push(wear.transpose()?);
         model.contacts.push(contact);
     }

@@ -123,8 +123,6 @@ impl WearInput {
     /// tube's radius `R_A` (or `scar.tube_radius`) and, for a `tube` scar, the other tube's
     /// `R_B` (or `scar.other_radius`; both given must agree); `obstacle` the pair's relative
     /// obstacle, `field` the contact. A tube against a flat bar has the tube as body A.
-    // for the two-body contacts of the `[[structures]]` case builder (issue 3.4)
-    #[cfg_attr(not(test), allow(dead_code))]
     pub(super) fn build_pair(
         &self,
         radii: [f64; 2],
