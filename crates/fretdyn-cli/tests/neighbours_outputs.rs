@@ -45,8 +45,8 @@ fn two_tubes(steps: u64) -> Case {
         points,
         [0.0, 0.0],
         Obstacle::Plane(plane),
-        support.normal.clone(),
-        support.friction.clone(),
+        support.normal,
+        support.friction,
     )
     .unwrap();
     model.contacts.push(pair);
