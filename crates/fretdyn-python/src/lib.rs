@@ -46,6 +46,25 @@ fn absolute(dir: &Path) -> PathBuf {
     std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf())
 }
 
+impl Case {
+    /// The name of the point `point` gives of each contact (empty for none).
+    fn contact_point_names(
+        &self,
+        point: impl Fn(&fretdyn::contact::Contact) -> Option<usize>,
+    ) -> Vec<String> {
+        let points = &self.inner.model.basis.points;
+        let contacts = &self.inner.model.contacts;
+        contacts
+            .iter()
+            .map(|c| {
+                point(c)
+                    .and_then(|i| points.get(i))
+                    .map_or_else(String::new, |p| p.name.clone())
+            })
+            .collect()
+    }
+}
+
 #[pymethods]
 impl Case {
     /// Title of the case.
@@ -86,18 +105,21 @@ impl Case {
     /// Names of the structure points of the contacts, in the order of the contacts.
     #[getter]
     fn contact_points(&self) -> Vec<String> {
-        let points = &self.inner.model.basis.points;
-        self.inner
-            .model
-            .contacts
-            .iter()
-            .map(|c| {
-                points
-                    .get(c.point)
-                    .map(|p| p.name.clone())
-                    .unwrap_or_default()
-            })
-            .collect()
+        self.contact_point_names(|c| Some(c.point))
+    }
+
+    /// Point B of each two-body contact (THEORY §15), empty for a contact with an obstacle,
+    /// in the order of the contacts.
+    #[getter]
+    fn contact_other_points(&self) -> Vec<String> {
+        self.contact_point_names(fretdyn::contact::Contact::other)
+    }
+
+    /// Names of the structures of a model of several (empty for a model of one).
+    #[getter]
+    fn structures(&self) -> Vec<String> {
+        let model = &self.inner.model;
+        model.structures.iter().map(|s| s.name.clone()).collect()
     }
 
     /// Natural frequencies of the basis, Hz.
@@ -575,14 +597,17 @@ fn variable_dict<'py>(
 /// (`modal`) or of one in physical coordinates, in the order of `results.npz`, each a dict
 /// with `key` (of `results.npz`), `name`, `dims`, `units`, `long_name`, `flag_meanings` and
 /// `coordinates` (its auxiliary coordinates, CF); and the coordinates besides `time` (the
-/// same keys but `key` and `coordinates`).
+/// same keys but `key` and `coordinates`), those of a model of several structures or with
+/// two-body contacts last.
 #[pyfunction]
 #[pyo3(signature = (modal = true))]
 fn variables<'py>(
     py: Python<'py>,
     modal: bool,
 ) -> PyResult<(Bound<'py, PyList>, Bound<'py, PyList>)> {
-    use fretdyn::output::variables::{COORDINATES, auxiliary_coordinates, time_histories};
+    use fretdyn::output::variables::{
+        COORDINATES, NEIGHBOUR_COORDINATES, auxiliary_coordinates, time_histories,
+    };
     let histories = PyList::empty(py);
     for h in time_histories(modal) {
         let d = variable_dict(py, &h.variable)?;
@@ -591,7 +616,7 @@ fn variables<'py>(
         histories.append(d)?;
     }
     let coordinates = PyList::empty(py);
-    for c in &COORDINATES {
+    for c in COORDINATES.iter().chain(&NEIGHBOUR_COORDINATES) {
         coordinates.append(variable_dict(py, &c.variable)?)?;
     }
     Ok((histories, coordinates))
@@ -599,14 +624,16 @@ fn variables<'py>(
 
 /// The values of the coordinates of a case's results besides `time` (`fretdyn::results::
 /// variables::COORDINATES`, as `results.nc` has them): a dict name → numpy array (int32 mode
-/// numbers, float64 numbers in the shape of their dimensions) or list of str (names); and
-/// whether the case's model is modal (else in physical coordinates).
+/// numbers, float64 numbers in the shape of their dimensions) or list of str (names), with
+/// `structure`, `mode_structure`, `point_structure` and `contact_other_point` for a model
+/// of several structures or with two-body contacts; and whether the case's model is modal
+/// (else in physical coordinates).
 #[pyfunction]
 fn coordinates<'py>(py: Python<'py>, case: &Case) -> PyResult<(Bound<'py, PyDict>, bool)> {
-    use fretdyn::output::variables::{COORDINATES, Labels, Values};
+    use fretdyn::output::variables::{Labels, Values};
     let labels = Labels::of(&case.inner.model);
     let out = PyDict::new(py);
-    for c in &COORDINATES {
+    for c in &labels.coordinates() {
         let v = &c.variable;
         let shape: Vec<usize> = v
             .dims

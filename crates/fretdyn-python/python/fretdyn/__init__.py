@@ -208,7 +208,11 @@ def variables(modal: bool = True) -> Tuple[List[dict], List[dict]]:
         ``flag_meanings`` of the coordinates besides ``time``: ``mode`` (numbers from 1) with
         ``frequency`` (Hz) and ``damping_ratio``; ``contact`` (names) with
         ``contact_point`` and ``contact_obstacle``; ``tangent``, ``local_axis``; ``point``
-        (names) with ``point_position`` (m, along ``direction``: x, y, z).
+        (names) with ``point_position`` (m, along ``direction``: x, y, z); and those only
+        the results of a model of several structures or with two-body contacts have:
+        ``structure`` (names) with ``mode_structure`` and ``point_structure`` (the
+        structure of each mode and point), ``contact_other_point`` (point B of a two-body
+        contact, empty for an obstacle).
 
     Examples
     --------
@@ -439,6 +443,19 @@ class Case:
     def contact_points(self) -> List[str]:
         """Names of the structure points of the contacts, in the order of the contacts."""
         return self._native.contact_points
+
+    @property
+    def contact_other_points(self) -> List[str]:
+        """Point B of each two-body contact (a contact between two points, of one structure
+        or two), empty for a contact with an obstacle, in the order of the contacts. The
+        results of a two-body contact (positions, slip) are of its point relative to it."""
+        return self._native.contact_other_points
+
+    @property
+    def structures(self) -> List[str]:
+        """Names of the structures of a model of several (``[[structures]]``; their points
+        and contacts are named ``structure.name``), empty for a model of one."""
+        return self._native.structures
 
     @property
     def frequencies_hz(self) -> np.ndarray:
@@ -714,7 +731,9 @@ class Result(Mapping):
         (s; the key ``t``), ``mode`` (numbers from 1) with ``frequency`` (Hz) and
         ``damping_ratio``, ``contact`` (names) with ``contact_point`` and
         ``contact_obstacle``, ``point`` (names) with ``point_position`` (m), and the labels
-        of ``tangent``, ``local_axis`` and ``direction``; every other array under its key.
+        of ``tangent``, ``local_axis`` and ``direction`` (and for a model of several
+        structures or with two-body contacts ``structure`` with ``mode_structure``,
+        ``point_structure``, and ``contact_other_point``); every other array under its key.
         Every variable has ``units`` (UDUNITS; names have none) and ``long_name``;
         ``contact_status`` has CF ``flag_values`` and ``flag_meanings``. The Dataset's
         attributes are ``title``, ``fretdyn_version``, ``comment`` and ``summary`` (the
@@ -756,6 +775,8 @@ class Result(Mapping):
 
         coords = {}
         for v in coords_table:
+            if v["name"] not in values:  # of several structures, two-body contacts
+                continue
             x = values[v["name"]]
             if isinstance(x, list):  # names
                 x = np.array(x, dtype=str)

@@ -9,7 +9,8 @@
 //! where the summary has `null` or no such key (a standard error with fewer than 2 batches,
 //! the volume rates of a contact without `wear`). The columns are [`columns`] (derived from the
 //! table of statistics, [`crate::accumulate::statistics::columns`]), always all of them and in
-//! that order, so that the tables of several runs stack; a key that the summary gains and
+//! that order, so that the tables of several runs stack (a model of several structures or
+//! with two-body contacts has [`POINT_COLUMNS`] after `name`); a key that the summary gains and
 //! [`columns`] does not know yet follows them (nested objects flattened with dotted
 //! names). Lists ([`LEFT_OUT`]: the peak-force histogram, whose bins differ per contact) stay
 //! in `summary.json` only. Written with the `csv` crate: a name with a comma, a quote or a
@@ -68,6 +69,23 @@ const CONTACT_COLUMNS: [Column; 2] = [
         "index of the contact in the case file (0 is the first [[contacts]]), as in impacts.csv",
     ),
     column("name", "", "INTITULE", "contact name"),
+];
+
+/// The columns after the name in a model of several structures or with two-body contacts
+/// (THEORY §15), when the summary's contacts have them.
+pub const POINT_COLUMNS: [Column; 2] = [
+    column(
+        "point",
+        "",
+        "NOEUD_1",
+        "the structure point of the contact (point A of a two-body contact)",
+    ),
+    column(
+        "other_point",
+        "",
+        "NOEUD_2",
+        "point B of a two-body contact (the forces act on point, their opposite on it; positions and slip are relative, of point with respect to it); empty for an obstacle",
+    ),
 ];
 
 /// The columns after the statistics: the wear volume rates of a contact with `wear`
@@ -166,6 +184,13 @@ pub fn contacts_table(summary: &Value) -> (Vec<String>, Vec<Vec<String>>) {
         })
         .unwrap_or_default();
     let mut header: Vec<String> = columns().iter().map(|c| c.key.to_string()).collect();
+    if contacts
+        .iter()
+        .any(|c| c.contains_key(POINT_COLUMNS[1].key))
+    {
+        let at = CONTACT_COLUMNS.len();
+        header.splice(at..at, POINT_COLUMNS.iter().map(|c| c.key.to_string()));
+    }
     let mut others: Vec<&String> = contacts
         .iter()
         .flat_map(|c| c.keys())
@@ -207,7 +232,7 @@ pub fn write_contacts_csv(dir: &Path, summary: &Value) -> Result<PathBuf> {
         let mut csv = csv::Writer::from_writer(std::io::BufWriter::new(file));
         csv.write_record(["column", "unit", "code_aster", "meaning"])
             .map_err(std::io::Error::other)?;
-        let columns = columns();
+        let columns: Vec<Column> = columns().into_iter().chain(POINT_COLUMNS).collect();
         for key in &header {
             let c = columns.iter().find(|c| c.key == key);
             csv.write_record([

@@ -5,7 +5,9 @@
 //!   [`crate::output::variables`], with its names, `units` (UDUNITS) and `long_name` (CF
 //!   `flag_values`/`flag_meanings` for `contact_status`), and nothing of its own: `time`
 //!   (unlimited; the `t` of `results.npz`), `mode`, `contact`, `tangent` (t1, t2),
-//!   `local_axis` (e1, e2), `point`, `direction` (x, y, z); the auxiliary coordinates in the
+//!   `local_axis` (e1, e2), `point`, `direction` (x, y, z), and for a model of several
+//!   structures `structure` (with `mode_structure`, `point_structure`) and of two-body
+//!   contacts `contact_other_point` ([`Labels::coordinates`]); the auxiliary coordinates in the
 //!   CF `coordinates` attribute of the variables along their dimensions, `point_position` in
 //!   the global one (xarray's convention);
 //! - every other key of `results.npz` under its own name, with the same numbers (bit for
@@ -49,7 +51,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 use crate::output::layout::{Dtype, NPY_HEADER, ResultsMetadata};
-use crate::output::variables::{self, COORDINATES, TIME, Values, Variable};
+use crate::output::variables::{self, TIME, Values, Variable};
 
 /// The names and reference values that label the arrays (see [`variables::Labels`]).
 pub use crate::output::variables::Labels;
@@ -228,7 +230,7 @@ fn write_to(
             file.add_attribute(name, vec![text.clone()]).map_err(nc)?;
         }
     }
-    let global = variables::global_coordinates();
+    let global = labels.global_coordinates();
     if !global.is_empty() {
         file.add_attribute("coordinates", global.join(" "))
             .map_err(nc)?;
@@ -237,7 +239,8 @@ fn write_to(
     // dimensions, in the order of their coordinates (a length 0, e.g. no contact, is an
     // unlimited dimension in netCDF-4: the arrays still have length 0 along it)
     file.add_unlimited_dimension(TIME).map_err(nc)?;
-    for c in &COORDINATES {
+    let coordinates = labels.coordinates();
+    for c in &coordinates {
         let name = c.variable.name;
         if c.variable.dims == [name] {
             let len = labels.dimension_len(name).ok_or_else(|| {
@@ -248,7 +251,7 @@ fn write_to(
     }
 
     // coordinates
-    for c in &COORDINATES {
+    for c in &coordinates {
         let v = &c.variable;
         match labels.values(c.source) {
             Values::Text(names) => strings(&mut file, v, &names)?,
@@ -293,7 +296,7 @@ fn write_to(
             v.put_attribute("flag_meanings", d.flag_meanings.join(" "))
                 .map_err(nc)?;
         }
-        let auxiliary = variables::auxiliary_coordinates(d.dims);
+        let auxiliary = labels.auxiliary_coordinates(d.dims);
         if !auxiliary.is_empty() {
             v.put_attribute("coordinates", auxiliary.join(" "))
                 .map_err(nc)?;

@@ -65,7 +65,7 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
             standard_errors["target_met_at"] = json!(t);
         }
     }
-    json!({
+    let mut summary = json!({
         "fretdyn_version": env!("CARGO_PKG_VERSION"),
         "title": case.title,
         "warnings": case.warnings,
@@ -96,18 +96,62 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
             "steps_per_second": results.steps_per_second(),
         },
         "case": case.echo,
-    })
+    });
+    if !case.model.structures.is_empty() {
+        summary["structures"] = structures(&case.model);
+    }
+    summary
+}
+
+/// The structures of a model of several (THEORY §15): each one's name and its modes, points
+/// and contacts (their names; its contacts are those with obstacles or between two of its
+/// own points, those between two structures are no one's).
+fn structures(model: &crate::model::Model) -> serde_json::Value {
+    let points = &model.basis.points;
+    json!(
+        model
+            .structures
+            .iter()
+            .map(|s| json!({
+                "name": s.name,
+                "modes": s.modes.len(),
+                "points": points[s.points.clone()].iter().map(|p| &p.name).collect::<Vec<_>>(),
+                "contacts": model.contacts[s.contacts.clone()]
+                    .iter()
+                    .map(|c| &c.name)
+                    .collect::<Vec<_>>(),
+            }))
+            .collect::<Vec<_>>()
+    )
 }
 
 /// The per-contact statistics; a contact with `wear` (docs/WEAR.md) also gets
 /// `tube_volume_rate` and `support_volume_rate`, m³/s, its laws at the run's wear work rate
 /// (friction or normal, as its `work` says) and service time 0 (THEORY §14); a two-body
-/// contact also `tube_body` and `support_body`, the names of its points A and B.
+/// contact also `tube_body` and `support_body`, the names of its points A and B. In a model of
+/// several structures or with two-body contacts, every contact also has its `point` and
+/// `other_point` (point B of a two-body contact, empty for an obstacle).
 fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
     let mut contacts = json!(results.contacts);
+    let model = &case.model;
+    let points = &model.basis.points;
+    let pairs = crate::output::variables::neighbours(model);
     if let Some(list) = contacts.as_array_mut() {
         for (k, (entry, stats)) in list.iter_mut().zip(&results.contacts).enumerate() {
-            if let (Some(w), Some(map)) = (case.model.contact_wear(k), entry.as_object_mut()) {
+            let Some(map) = entry.as_object_mut() else {
+                continue;
+            };
+            if pairs {
+                // the contact's points: A, and B of a two-body contact (empty for an obstacle)
+                let c = &model.contacts[k];
+                let name = |i: Option<usize>| {
+                    i.and_then(|i| points.get(i))
+                        .map_or_else(String::new, |p| p.name.clone())
+                };
+                map.insert("point".into(), json!(name(Some(c.point))));
+                map.insert("other_point".into(), json!(name(c.other())));
+            }
+            if let Some(w) = model.contact_wear(k) {
                 let (tube, support) = w.volume_rates(w.work.rate(stats), 0.0);
                 map.insert("tube_volume_rate".into(), json!(tube));
                 map.insert("support_volume_rate".into(), json!(support));

@@ -13,7 +13,12 @@
 //! - the coordinates ([`COORDINATES`]): `mode` (numbers from 1) with `frequency` and
 //!   `damping_ratio`; `contact` (names) with `contact_point` and `contact_obstacle`; `point`
 //!   (names) with `point_position`; the labels of `tangent`, `local_axis` and `direction`.
-//!   Their values come from the model ([`Labels`]).
+//!   Their values come from the model ([`Labels`]);
+//! - of a model of several structures or with two-body contacts only (THEORY §15), after
+//!   them ([`NEIGHBOUR_COORDINATES`], [`Labels::coordinates`]): `structure` (names, a
+//!   dimension) with `mode_structure` and `point_structure` (the structure of each mode and
+//!   point), and `contact_other_point` (point B of a two-body contact, empty for an
+//!   obstacle). A model of one structure without them keeps its files as they were.
 //!
 //! Units are UDUNITS strings, products by a space and powers by a number (`m s-1`,
 //! `kg^0.5 m`); `1` for a dimensionless number or a code; names have none. The modal
@@ -21,7 +26,7 @@
 //! displacement is the mode shape (m kg^-0.5) times `q`. A model in physical coordinates
 //! ([`crate::model::Coordinates::Physical`]) has `q` in m and `q̇` in `m s-1`.
 
-use crate::model::{Coordinates, Model};
+use crate::model::{Coordinates, Model, StructureRange};
 
 /// Dimension of the samples (`[output] every` decimates); unlimited in `results.nc`.
 pub const TIME: &str = "time";
@@ -39,6 +44,8 @@ pub const LOCAL_AXIS: &str = "local_axis";
 pub const POINT: &str = "point";
 /// Dimension of the three components of a position in the global frame (`x`, `y`, `z`).
 pub const DIRECTION: &str = "direction";
+/// Dimension of the structures of a model of several (THEORY §15); absent otherwise.
+pub const STRUCTURE: &str = "structure";
 
 /// A variable or coordinate as `results.nc` and `to_xarray()` name and describe it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -86,6 +93,14 @@ pub enum Source {
     PointNames,
     /// The points' reference positions, row-major (point, direction), m.
     PointPositions,
+    /// The structures' names (a model of several).
+    StructureNames,
+    /// The name of each mode's structure.
+    ModeStructures,
+    /// The name of each point's structure.
+    PointStructures,
+    /// The name of point B of each two-body contact, empty for a contact with an obstacle.
+    ContactOtherPoints,
     /// Fixed labels.
     Fixed(&'static [&'static str]),
 }
@@ -315,6 +330,43 @@ pub const COORDINATES: [Coordinate; 11] = [
     },
 ];
 
+/// The coordinates of a model of several structures (the first three) or with two-body
+/// contacts (the last), after [`COORDINATES`]; [`Labels::coordinates`] says which a model
+/// has. Names, as `contact_point`: `ds.q.where(ds.mode_structure == "tube_a")`.
+pub const NEIGHBOUR_COORDINATES: [Coordinate; 4] = [
+    Coordinate {
+        variable: v(STRUCTURE, &[STRUCTURE], None, "structure name"),
+        source: Source::StructureNames,
+    },
+    Coordinate {
+        variable: v(
+            "mode_structure",
+            &[MODE],
+            None,
+            "the structure whose mode (or degree of freedom) it is",
+        ),
+        source: Source::ModeStructures,
+    },
+    Coordinate {
+        variable: v(
+            "point_structure",
+            &[POINT],
+            None,
+            "the structure of the point",
+        ),
+        source: Source::PointStructures,
+    },
+    Coordinate {
+        variable: v(
+            "contact_other_point",
+            &[CONTACT],
+            None,
+            "point B of a two-body contact (its forces act on contact_point, their opposite on it; recorded positions and velocities are of contact_point relative to it); empty for an obstacle",
+        ),
+        source: Source::ContactOtherPoints,
+    },
+];
+
 /// The global attribute `comment` of `results.nc` and of `to_xarray()`.
 pub const COMMENT: &str = "the arrays of results.npz under their keys, t as the coordinate time (README, \"Reading the results\")";
 
@@ -323,7 +375,11 @@ pub const COMMENT: &str = "the arrays of results.npz under their keys, t as the 
 /// attribute (`q`: `frequency damping_ratio`; a contact's: `contact_point
 /// contact_obstacle`).
 pub fn auxiliary_coordinates(dims: &[&str]) -> Vec<&'static str> {
-    COORDINATES
+    auxiliary_among(&COORDINATES, dims)
+}
+
+fn auxiliary_among(coordinates: &[Coordinate], dims: &[&str]) -> Vec<&'static str> {
+    coordinates
         .iter()
         .map(|c| &c.variable)
         .filter(|c| c.dims != [c.name] && c.dims.iter().all(|d| dims.contains(d)))
@@ -334,14 +390,23 @@ pub fn auxiliary_coordinates(dims: &[&str]) -> Vec<&'static str> {
 /// The auxiliary coordinates along the dimensions of no time history (`point_position`):
 /// xarray reads them as coordinates from the global attribute `coordinates`.
 pub fn global_coordinates() -> Vec<&'static str> {
+    global_among(&COORDINATES)
+}
+
+fn global_among(coordinates: &[Coordinate]) -> Vec<&'static str> {
     let attached: Vec<&str> = MODAL
         .iter()
-        .flat_map(|h| auxiliary_coordinates(h.variable.dims))
+        .flat_map(|h| auxiliary_among(coordinates, h.variable.dims))
         .collect();
-    auxiliary_coordinates(&[MODE, CONTACT, TANGENT, LOCAL_AXIS, POINT, DIRECTION])
-        .into_iter()
-        .filter(|c| !attached.contains(c))
-        .collect()
+    auxiliary_among(
+        coordinates,
+        &[
+            MODE, CONTACT, TANGENT, LOCAL_AXIS, POINT, DIRECTION, STRUCTURE,
+        ],
+    )
+    .into_iter()
+    .filter(|c| !attached.contains(c))
+    .collect()
 }
 
 /// The time history or coordinate called `name` (in `results.nc`; `t` is `time`), of a modal
@@ -351,6 +416,7 @@ pub fn find(name: &str) -> Option<Variable> {
         .iter()
         .map(|h| h.variable)
         .chain(COORDINATES.iter().map(|c| c.variable))
+        .chain(NEIGHBOUR_COORDINATES.iter().map(|c| c.variable))
         .find(|v| v.name == name)
 }
 
@@ -379,6 +445,13 @@ pub struct Labels {
     frequencies_hz: Vec<f64>,
     damping_ratios: Vec<f64>,
     modal: bool,
+    /// The structures' names, empty for a model of one.
+    structures: Vec<String>,
+    mode_structures: Vec<String>,
+    point_structures: Vec<String>,
+    /// Point B of each contact, `None` when the model has no two-body contact and one
+    /// structure.
+    contact_other_points: Option<Vec<String>>,
 }
 
 impl Labels {
@@ -410,7 +483,51 @@ impl Labels {
                 .collect(),
             damping_ratios: b.damping_ratio.clone(),
             modal: matches!(model.coordinates, Coordinates::Modal),
+            structures: model.structures.iter().map(|s| s.name.clone()).collect(),
+            mode_structures: owners(model, b.modes(), |s| &s.modes),
+            point_structures: owners(model, b.points.len(), |s| &s.points),
+            contact_other_points: neighbours(model).then(|| {
+                model
+                    .contacts
+                    .iter()
+                    .map(|c| {
+                        c.other()
+                            .and_then(|k| b.points.get(k))
+                            .map_or_else(String::new, |p| p.name.clone())
+                    })
+                    .collect()
+            }),
         }
+    }
+
+    /// The coordinates of the results besides `time`, in the order `results.nc` writes them:
+    /// [`COORDINATES`], then those of [`NEIGHBOUR_COORDINATES`] the model has (the structures'
+    /// of a model of several, `contact_other_point` of one with two-body contacts or several
+    /// structures).
+    pub fn coordinates(&self) -> Vec<Coordinate> {
+        let several = !self.structures.is_empty();
+        let pairs = self.contact_other_points.is_some();
+        COORDINATES
+            .into_iter()
+            .chain(
+                NEIGHBOUR_COORDINATES
+                    .into_iter()
+                    .filter(|c| match c.source {
+                        Source::ContactOtherPoints => pairs,
+                        _ => several,
+                    }),
+            )
+            .collect()
+    }
+
+    /// [`auxiliary_coordinates`] among [`Self::coordinates`].
+    pub fn auxiliary_coordinates(&self, dims: &[&str]) -> Vec<&'static str> {
+        auxiliary_among(&self.coordinates(), dims)
+    }
+
+    /// [`global_coordinates`] among [`Self::coordinates`].
+    pub fn global_coordinates(&self) -> Vec<&'static str> {
+        global_among(&self.coordinates())
     }
 
     /// `q` are modal coordinates (else physical ones, in m): the argument of
@@ -428,6 +545,7 @@ impl Labels {
             TANGENT | LOCAL_AXIS => Some(2),
             POINT => Some(self.points.len()),
             DIRECTION => Some(3),
+            STRUCTURE => Some(self.structures.len()),
             _ => None,
         }
     }
@@ -448,9 +566,43 @@ impl Labels {
             ),
             Source::PointNames => Values::Text(self.points.clone()),
             Source::PointPositions => Values::Float(self.point_positions.clone()),
+            Source::StructureNames => Values::Text(self.structures.clone()),
+            Source::ModeStructures => Values::Text(self.mode_structures.clone()),
+            Source::PointStructures => Values::Text(self.point_structures.clone()),
+            Source::ContactOtherPoints => {
+                Values::Text(self.contact_other_points.clone().unwrap_or_default())
+            }
             Source::Fixed(labels) => Values::Text(labels.iter().map(|s| s.to_string()).collect()),
         }
     }
+}
+
+/// The model has several structures or a two-body contact: its results then say each
+/// contact's second point (`contact_other_point`, `other_point`), and are otherwise as
+/// those of a model of one structure.
+pub fn neighbours(model: &Model) -> bool {
+    !model.structures.is_empty() || model.contacts.iter().any(|c| c.pair.is_some())
+}
+
+/// For each of `n` modes or points, the name of the structure whose `range` holds it (none
+/// for a model of one structure).
+fn owners(
+    model: &Model,
+    n: usize,
+    range: impl Fn(&StructureRange) -> &std::ops::Range<usize>,
+) -> Vec<String> {
+    if model.structures.is_empty() {
+        return Vec::new();
+    }
+    (0..n)
+        .map(|i| {
+            model
+                .structures
+                .iter()
+                .find(|s| range(s).contains(&i))
+                .map_or_else(String::new, |s| s.name.clone())
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -562,6 +714,43 @@ mod tests {
         for (f, w) in f.iter().zip(&model.basis.omega) {
             assert!((f * std::f64::consts::TAU - w).abs() <= 1e-12 * w);
         }
+    }
+
+    /// A model of one structure has the coordinates it always had (its `results.nc` and
+    /// `to_xarray()` are unchanged); the union of two tubes has the structures' too, naming
+    /// each mode's and point's structure (the prefix of the point's name), and no second
+    /// point (no two-body contact). `tests/neighbours_outputs.rs` of the CLI reads them back.
+    #[test]
+    fn several_structures_label_modes_and_points() {
+        let one = Labels::of(&tube());
+        assert_eq!(one.coordinates(), COORDINATES);
+        assert_eq!(one.global_coordinates(), global_coordinates());
+        let union = Model::union(vec![("a".into(), tube()), ("b".into(), tube())]).unwrap();
+        let labels = Labels::of(&union);
+        assert_eq!(
+            labels.coordinates()[COORDINATES.len()..],
+            NEIGHBOUR_COORDINATES
+        );
+        let text = |s| match labels.values(s) {
+            Values::Text(t) => t,
+            _ => panic!(),
+        };
+        assert_eq!(text(Source::StructureNames), ["a", "b"]);
+        let p = tube().basis.modes();
+        let modes = text(Source::ModeStructures);
+        assert_eq!(modes.len(), 2 * p);
+        assert!(modes[..p].iter().all(|s| s == "a") && modes[p..].iter().all(|s| s == "b"));
+        let owners: Vec<String> = text(Source::PointNames)
+            .iter()
+            .map(|p| p.split_once('.').unwrap().0.to_string())
+            .collect();
+        assert_eq!(text(Source::PointStructures), owners);
+        let others = text(Source::ContactOtherPoints);
+        assert!(others.len() == union.contacts.len() && others.iter().all(String::is_empty));
+        assert_eq!(
+            labels.global_coordinates(),
+            ["point_position", "point_structure"]
+        );
     }
 
     /// Modal coordinates are in kg^0.5 m; physical ones in m (m s-1 for the velocities);
