@@ -23,7 +23,7 @@ def two_tubes(tmp_path_factory):
     path.write_text(text.replace("duration = 10.0", "duration = 1.0"))
     p = cli(["run", str(path), "-o", "out", "-q", "--no-plots"], tmp)
     assert p.returncode == 0, p.stderr
-    return tmp / "out", fretdyn.Case.load(path), fretdyn.run(path)
+    return tmp / "out", fretdyn.Case.from_file(path), fretdyn.run(path)
 
 
 def test_the_case_names_its_structures_and_the_second_points(two_tubes):
