@@ -341,15 +341,52 @@ fn bad_input_of_several_structures_names_its_field() {
             "contacts[0].radii",
             "other",
         ),
-        (
-            format!("{SETTINGS}{entry}{b}[life]\ntarget_years = 1.0\ncriterion_depth = 1e-4\n"),
-            "life",
-            "not supported yet",
-        ),
     ];
     for (text, field, words) in cases {
         let e = parse(&text).unwrap_err();
         assert_eq!(field_of(&e), field, "{e}");
         assert!(e.to_string().contains(words), "{e}");
     }
+}
+
+/// `[life]` in a case of several structures (`examples/tube_to_tube.toml`, windows of 1 s):
+/// the two-body contact wears both tubes — equal laws and equal radii, so equal depths — and
+/// the gap opens by their approach, more than either depth and less than their sum
+/// (THEORY §15); the criterion is a depth in m (no one tube's wall to take a fraction of).
+#[test]
+fn a_service_life_of_two_tubes_wears_both() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let text = std::fs::read_to_string(root.join("tube_to_tube.toml")).unwrap();
+    assert!(text.contains("duration = 10.0"));
+    let text = text.replace("duration = 10.0", "duration = 1.0");
+    let case = parse(&format!(
+        "{text}\n[life]\ntarget_years = 40.0\ncriterion_depth = 4e-4\n"
+    ))
+    .unwrap();
+    let life = case.life.clone().unwrap();
+    assert_eq!(life.wall, None);
+    let r = fretdyn::service_life(&case, &life, |_| {}).unwrap();
+    assert_eq!(r.end, fretdyn::apps::life::LifeEnd::Completed);
+    assert_eq!(r.contacts, vec!["tube_to_tube".to_string()]);
+    assert_eq!(
+        r.bodies,
+        vec![Some(["tube_a.mid".to_string(), "tube_b.mid".to_string()])]
+    );
+    let last = &r.steps.last().unwrap().contacts[0];
+    assert!(last.tube_depth > 1e-7, "{}", last.tube_depth);
+    assert!(
+        (last.tube_depth - last.support_depth).abs() <= 1e-12 * last.tube_depth,
+        "{} vs {}",
+        last.tube_depth,
+        last.support_depth
+    );
+    assert!(last.clearance_increase > last.tube_depth);
+    assert!(last.clearance_increase < last.tube_depth + last.support_depth);
+    // a fraction of the wall needs one tube
+    let e = parse(&format!(
+        "{text}\n[life]\ntarget_years = 40.0\ncriterion_wall_fraction = 0.4\n"
+    ))
+    .unwrap_err();
+    assert_eq!(field_of(&e), "life.criterion_wall_fraction");
+    assert!(e.to_string().contains("criterion_depth"), "{e}");
 }

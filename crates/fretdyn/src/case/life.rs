@@ -71,7 +71,7 @@ impl LifeSection {
                 let tube = tube.ok_or_else(|| {
                     Error::invalid(
                         "life.criterion_wall_fraction",
-                        "needs a type = \"tube\" structure (its wall_thickness): give criterion_depth in m instead",
+                        "needs one type = \"tube\" structure (its wall_thickness; a case of several structures has no one wall): give criterion_depth in m instead",
                     )
                 })?;
                 Some(f * tube.structure.beam.tube.section.wall_thickness)

@@ -127,12 +127,8 @@ impl Case {
         let title = file.title.clone().unwrap_or_default();
         let life_section = file.life.take();
         let (model, settings, tube, flow, point_abscissae) = file.build(base, &mut warnings)?;
-        if life_section.is_some() && !model.structures.is_empty() {
-            return Err(Error::invalid(
-                "life",
-                "a service life of several structures is not supported yet: run the [life] of each structure in a case of its own, or remove [life] to run the case",
-            ));
-        }
+        // several structures: no one tube's wall (the criterion is then given in m, and
+        // the perforation of a wall is not checked)
         let life = match life_section {
             Some(l) => Some(l.build(tube.as_deref())?),
             None => None,
