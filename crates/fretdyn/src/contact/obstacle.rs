@@ -118,6 +118,21 @@ impl Plane {
     }
 }
 
+/// The offset of `x` from the line through `centre` along the unit `axis`, normal to it:
+/// its length `ρ` and direction (`e1` when `x` is on the line) — a hole's and a rod's frame.
+#[inline(always)]
+fn radial_offset(
+    centre: &Vector3<f64>,
+    axis: &Vector3<f64>,
+    e1: &Vector3<f64>,
+    x: &Vector3<f64>,
+) -> (f64, Vector3<f64>) {
+    let d = x - centre;
+    let r = d - axis * axis.dot(&d);
+    let rho = r.norm();
+    (rho, if rho > 0.0 { r / rho } else { *e1 })
+}
+
 /// A first tangent for a normal `n`: the global axis least aligned with `n`, projected.
 fn default_tangent(n: &Vector3<f64>) -> Vector3<f64> {
     let axes = [Vector3::x(), Vector3::y(), Vector3::z()];
@@ -183,10 +198,7 @@ impl Circle {
 
     #[inline]
     fn frame(&self, x: &Vector3<f64>) -> ContactFrame {
-        let d = x - self.centre;
-        let r = d - self.axis * self.axis.dot(&d);
-        let rho = r.norm();
-        let radial = if rho > 0.0 { r / rho } else { self.e1 };
+        let (rho, radial) = radial_offset(&self.centre, &self.axis, &self.e1, x);
         if let Some(scar) = &self.scar {
             return self.worn_frame(scar, rho, radial);
         }
@@ -488,10 +500,7 @@ impl Cylinder {
 
     #[inline]
     fn frame(&self, x: &Vector3<f64>) -> ContactFrame {
-        let d = x - self.centre;
-        let r = d - self.axis * self.axis.dot(&d);
-        let rho = r.norm();
-        let radial = if rho > 0.0 { r / rho } else { self.e1 };
+        let (rho, radial) = radial_offset(&self.centre, &self.axis, &self.e1, x);
         ContactFrame {
             penetration: self.radius - rho,
             normal: radial,
