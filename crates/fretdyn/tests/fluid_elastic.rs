@@ -99,6 +99,7 @@ fn settings(dt: f64, duration: f64) -> RunSettings {
         }),
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1,
+        monitors: Vec::new(),
         statistics: Default::default(),
     }
 }

@@ -71,6 +71,7 @@ fn settings(
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1,
+        monitors: Vec::new(),
         statistics: stats,
     }
 }

@@ -133,6 +133,7 @@ fn run(method: TangentialMethod, dt: f64, duration: f64, t_start: f64) -> RunRes
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1000,
+        monitors: Vec::new(),
         statistics: StatisticsSettings {
             t_start,
             ..Default::default()

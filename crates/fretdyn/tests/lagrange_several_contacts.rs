@@ -900,6 +900,7 @@ fn time_step_above_the_stable_limit_is_refused_with_the_limit_in_the_message() {
         method: gs(),
         stick_velocity: Default::default(),
         output_every: 1,
+        monitors: Vec::new(),
         statistics: Default::default(),
     };
     let err = simulate(&model, &settings).expect_err("Δt above the limit must be refused");
@@ -948,6 +949,7 @@ fn time_step_just_below_the_limit_is_stable() {
         method: gs(),
         stick_velocity: Default::default(),
         output_every: 1,
+        monitors: Vec::new(),
         statistics: Default::default(),
     };
     let r = run(&model, &settings, |_| ControlFlow::Continue(())).unwrap();

@@ -164,6 +164,7 @@ fn settings(method: TangentialMethod) -> RunSettings {
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1,
+        monitors: Vec::new(),
         statistics: Default::default(),
     }
 }

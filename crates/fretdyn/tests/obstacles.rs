@@ -19,6 +19,7 @@ fn settings(method: TangentialMethod, dt: f64, steps: u64, every: u64) -> RunSet
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: every,
+        monitors: Vec::new(),
         statistics: Default::default(),
     }
 }

@@ -68,6 +68,7 @@ fn settings(method: TangentialMethod, dt: f64, steps: u64, t_start: f64) -> RunS
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1,
+        monitors: Vec::new(),
         statistics: StatisticsSettings {
             t_start,
             ..Default::default()

@@ -47,6 +47,7 @@ fn settings(
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1000,
+        monitors: Vec::new(),
         statistics: stats,
     }
 }

@@ -57,6 +57,7 @@ fn run(model: &Model, dt: f64) -> RunResults {
         method: TangentialMethod::GaussSeidel(GaussSeidelSettings::default()),
         stick_velocity: StickVelocity::HalfStep,
         output_every: 100,
+        monitors: Vec::new(),
         statistics: Default::default(),
     };
     simulate(model, &settings).unwrap()

@@ -97,6 +97,7 @@ fn settings(dt: f64, duration: f64, method: TangentialMethod) -> RunSettings {
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1,
+        monitors: Vec::new(),
         statistics: Default::default(),
     }
 }

@@ -6,11 +6,13 @@
 //! - [`recorder`]: the sampled time histories kept in memory;
 //! - [`statistics`]: per-contact wear work rate, impacts, slip, blocks (THEORY §5, §11);
 //! - [`energy`]: the discrete energy balance (THEORY §5);
-//! - [`wear_map`]: where each contact's friction work is done, for the service life.
+//! - [`wear_map`]: where each contact's friction work is done, for the service life;
+//! - [`monitor`]: the displacement of points along directions, at the output samples.
 //!
-//! The step loop ([`crate::integrator`]) writes into all four.
+//! The step loop ([`crate::integrator`]) writes into all five.
 
 pub mod energy;
+pub mod monitor;
 pub mod recorder;
 pub mod statistics;
 pub mod wear_map;

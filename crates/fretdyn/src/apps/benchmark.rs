@@ -123,6 +123,7 @@ pub fn rattling_tube(modes: usize, contacts: usize, method: TangentialMethod, st
             method,
             stick_velocity: StickVelocity::HalfStep,
             output_every: 100,
+            monitors: Vec::new(),
             statistics: Default::default(),
         },
     )

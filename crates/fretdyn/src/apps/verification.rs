@@ -147,6 +147,7 @@ impl V1 {
             method,
             stick_velocity,
             output_every: 1,
+            monitors: Vec::new(),
             statistics: Default::default(),
         }
     }

@@ -1,6 +1,7 @@
 //! `[time]`, `[tangential]`, `[output]`, `[statistics]`: the numerical settings of a run
 //! (THEORY §2, §4, §5).
 
+use nalgebra::Vector3;
 use serde::Deserialize;
 
 use crate::accumulate::statistics::StatisticsSettings;
@@ -10,8 +11,11 @@ use crate::contact::tangential::{
 };
 use crate::error::{Error, Result, number};
 use crate::integrator::simulation::RunSettings;
+use crate::settings::Monitor;
 use crate::integrator::stability::checked_stable_time_step;
 use crate::model::Model;
+
+use super::shared::point_index;
 
 /// `[statistics]`: the window, blocks (batches), standard errors and their target, impact
 /// definition and wear coefficient (THEORY §5).
@@ -170,11 +174,61 @@ fn default_max_iterations() -> usize {
 pub(super) struct OutputSection {
     #[serde(default = "one")]
     every: u64,
+    #[serde(default)]
+    monitors: Vec<MonitorInput>,
 }
 
 impl Default for OutputSection {
     fn default() -> Self {
-        Self { every: 1 }
+        Self {
+            every: 1,
+            monitors: Vec::new(),
+        }
+    }
+}
+
+/// `[[output.monitors]]`: the displacement of a point along a direction
+/// ([`crate::accumulate::monitor`]).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct MonitorInput {
+    /// Name in the outputs (default: the point's).
+    name: Option<String>,
+    point: String,
+    direction: [f64; 3],
+}
+
+impl OutputSection {
+    /// The monitors, their points found in `model` and their directions made unit.
+    fn monitors(&self, model: &Model) -> Result<Vec<Monitor>> {
+        let mut names = std::collections::HashSet::new();
+        let mut out = Vec::with_capacity(self.monitors.len());
+        for (i, m) in self.monitors.iter().enumerate() {
+            let field = format!("output.monitors[{i}]");
+            let point = point_index(&m.point, format!("{field}.point"), model)?;
+            let d = Vector3::from(m.direction);
+            let norm = d.norm();
+            if !(norm.is_finite() && norm > 0.0) {
+                return Err(Error::invalid(
+                    format!("{field}.direction"),
+                    "must be a non-zero finite vector, e.g. [0.0, 0.0, 1.0] (the displacement along it is monitored)",
+                ));
+            }
+            let name = m.name.clone().unwrap_or_else(|| m.point.clone());
+            if !names.insert(name.clone()) {
+                return Err(Error::invalid(
+                    format!("{field}.name"),
+                    format!("`{name}` names another monitor: give each its own name"),
+                ));
+            }
+            out.push(Monitor {
+                name,
+                point,
+                point_name: m.point.clone(),
+                direction: d / norm,
+            });
+        }
+        Ok(out)
     }
 }
 
@@ -309,6 +363,7 @@ impl SettingsSections<'_> {
                 StickVelocityName::FullStep => StickVelocity::FullStep,
             },
             output_every: self.output.every,
+            monitors: self.output.monitors(model)?,
             statistics: StatisticsSettings {
                 t_start: self.statistics.t_start,
                 t_end: self.statistics.t_end.unwrap_or(f64::INFINITY),

@@ -22,8 +22,8 @@ pub const CHECKPOINT_MAGIC: &[u8; 8] = b"FRETDYNC";
 /// statistics' steps per contact and accumulated blocks when there were none; 4 had blocks
 /// only when set, and no batch moments; 5 had the angle of an impact's peak formed at the
 /// peak, not its direction; 6 was a snapshot copied field by field, not the run's state as
-/// it is).
-pub const CHECKPOINT_FORMAT: u32 = 7;
+/// it is; 7 had no displacement monitors).
+pub const CHECKPOINT_FORMAT: u32 = 8;
 
 /// What `checkpoint.bin` holds after its header: the run's [`Snapshot`] (its
 /// [`State`](crate::integrator::simulation::State) as it is) and the length of every file of

@@ -47,7 +47,8 @@ pub fn write_results_npz(dir: &Path, results: &RunResults) -> Result<PathBuf> {
 /// The JSON summary of a run: the case echoed, per-contact statistics with their standard
 /// errors (`<statistic>_se`, `batches`, `batch_length`, `batch_autocorrelation`,
 /// `batches_correlated`), the standard errors' settings and whether a target was met,
-/// energy balance, solver statistics, steps, wall time and steps/s.
+/// energy balance, solver statistics, steps, wall time and steps/s; the displacement
+/// `monitors` when the case has some.
 pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
     let s = &results.solver;
     let st = &case.settings.statistics;
@@ -99,6 +100,9 @@ pub fn summary(case: &crate::case::Case, results: &RunResults) -> serde_json::Va
     });
     if !case.model.structures.is_empty() {
         summary["structures"] = structures(&case.model);
+    }
+    if !results.monitors.is_empty() {
+        summary["monitors"] = json!(results.monitors);
     }
     summary
 }

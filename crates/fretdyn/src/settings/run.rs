@@ -1,5 +1,6 @@
 //! The numerical settings of a run ([`RunSettings`]) and their checks.
 
+use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::contact::tangential::{StickVelocity, TangentialMethod};
@@ -21,6 +22,23 @@ pub struct RunSettings {
     pub output_every: u64,
     /// Window, blocks and impact definition of the statistics.
     pub statistics: StatisticsSettings,
+    /// Displacements of points along directions whose statistics the run reports
+    /// ([`crate::accumulate::monitor`]).
+    pub monitors: Vec<Monitor>,
+}
+
+/// A displacement monitor: the displacement `u = d·(Φ_x q)` of the model's point `point`
+/// along the unit direction `d` (THEORY §5).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Monitor {
+    /// Name in the outputs.
+    pub name: String,
+    /// Index of the point in the model's basis.
+    pub point: usize,
+    /// The point's name.
+    pub point_name: String,
+    /// Unit direction `d`.
+    pub direction: Vector3<f64>,
 }
 
 impl RunSettings {
@@ -39,6 +57,15 @@ impl RunSettings {
             ));
         }
         self.statistics.validate("statistics")?;
+        for (i, m) in self.monitors.iter().enumerate() {
+            let norm = m.direction.norm();
+            if !(norm.is_finite() && (norm - 1.0).abs() < 1e-12) {
+                return Err(Error::invalid(
+                    format!("output.monitors[{i}].direction"),
+                    "must be a unit vector (the case file's is normalised when read)",
+                ));
+            }
+        }
         match &self.method {
             TangentialMethod::Penalty(p) => {
                 if !(p.stiffness.is_finite() && p.stiffness > 0.0) {

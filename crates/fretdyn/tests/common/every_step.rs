@@ -11,6 +11,7 @@ pub fn every_step(method: TangentialMethod, dt: f64, steps: u64) -> RunSettings 
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1,
+        monitors: Vec::new(),
         statistics: Default::default(),
     }
 }

@@ -30,6 +30,7 @@ pub fn run(model: &Model, case: &Case, method: TangentialMethod) -> RunResults {
         method,
         stick_velocity: StickVelocity::HalfStep,
         output_every: 1,
+        monitors: Vec::new(),
         statistics: Default::default(),
         ..case.settings.clone()
     };

@@ -436,15 +436,33 @@ impl Study {
         out
     }
 
+    /// The names of the base case's displacement monitors (`[[output.monitors]]`: its `name`,
+    /// or its `point`).
+    pub fn monitor_names(&self) -> Vec<String> {
+        let monitors = self.base.get("output").and_then(|o| o.get("monitors"));
+        let Some(toml::Value::Array(monitors)) = monitors else {
+            return Vec::new();
+        };
+        monitors
+            .iter()
+            .map(|m| {
+                let name = m.get("name").or_else(|| m.get("point"));
+                name.and_then(|n| n.as_str()).unwrap_or_default().to_string()
+            })
+            .collect()
+    }
+
     /// Header of the table: run, each parameter column ([`Self::columns`]), `sample` (in a
     /// probabilistic study), seed, status, steps/s, then `<contact>.<statistic>` for every
-    /// contact of the base case, then [`CONNORS_COLUMN`].
+    /// contact of the base case, `<monitor>.<column>` for every monitor, then
+    /// [`CONNORS_COLUMN`].
     pub fn header(&self, contacts: &[String]) -> String {
         table::header(
             self.columns().into_iter().map(|c| c.key),
             self.sampling.is_some(),
             self.has_life(),
             contacts,
+            &self.monitor_names(),
         )
     }
 

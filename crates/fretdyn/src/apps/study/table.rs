@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use crate::accumulate::monitor::MONITOR_COLUMNS;
 use crate::error::{Error, Result};
 use crate::integrator::simulation::{RunResults, Termination};
 
@@ -25,12 +26,14 @@ pub fn table_errors() -> impl Iterator<Item = &'static str> {
 /// The header of a study's table: `run`, the `parameters` columns ([`Study::columns`](super::Study::columns)),
 /// `sample` (with `sampling`, a probabilistic study), seed, status, steps/s, then
 /// `<contact>.<statistic>` for every contact of the base case, the [`LIFE_COLUMNS`] with
-/// `life` (a study of service lives), then [`CONNORS_COLUMN`] and [`FINGERPRINT_COLUMN`].
+/// `life` (a study of service lives), `<monitor>.<column>` ([`MONITOR_COLUMNS`]) for every
+/// displacement monitor, then [`CONNORS_COLUMN`] and [`FINGERPRINT_COLUMN`].
 pub(super) fn header(
     parameters: impl IntoIterator<Item = String>,
     sampling: bool,
     life: bool,
     contacts: &[String],
+    monitors: &[String],
 ) -> String {
     let mut cols = vec!["run".to_string()];
     cols.extend(parameters);
@@ -54,6 +57,9 @@ pub(super) fn header(
             }
         }
     }
+    for m in monitors {
+        cols.extend(MONITOR_COLUMNS.map(|s| format!("{m}.{s}")));
+    }
     cols.push(CONNORS_COLUMN.to_string());
     cols.push(FINGERPRINT_COLUMN.to_string());
     cols.join(",")
@@ -61,7 +67,7 @@ pub(super) fn header(
 
 /// A row of the table: `cols`, the run's own cells (index, values, sample, seed), then how its
 /// run `r` ended and its speed, the statistics of `r` per contact, the `life` cells of a study
-/// of service lives ([`LIFE_COLUMNS`]), the largest Connors ratio of its case
+/// of service lives ([`LIFE_COLUMNS`]), its monitors' cells, the largest Connors ratio of its case
 /// ([`CONNORS_COLUMN`]) and the `fingerprint` of its inputs: the columns of [`header`].
 pub(super) fn row(
     mut cols: Vec<String>,
@@ -90,6 +96,10 @@ pub(super) fn row(
         }
     }
     cols.extend(life.into_iter().flatten());
+    for m in &r.monitors {
+        let cells = m.cells().map(|x| x.map(|x| x.to_string()).unwrap_or_default());
+        cols.extend(cells);
+    }
     cols.push(connors.map(|x| x.to_string()).unwrap_or_default());
     cols.push(fingerprint);
     cols.join(",")

@@ -5,6 +5,7 @@ use super::contact_kinds::ContactKinds;
 use super::results::{RunResults, Termination};
 use super::step::Simulation;
 use super::workspace::contact_rows;
+use crate::accumulate::monitor::MonitorStatistics;
 use crate::accumulate::recorder::{ContactSample, Recorder};
 use crate::numerics::Lanes;
 use crate::structure::modal::recombine;
@@ -90,7 +91,20 @@ impl Simulation<'_> {
                 },
             );
         }
+        if non_finite.is_none() && self.settings.statistics.step_in_window(t, self.settings.dt) {
+            self.monitor_sample();
+        }
         non_finite
+    }
+
+    /// Adds the displacements `u = d·(Φ_x q)` of the monitors at the current step to their
+    /// sums ([`crate::accumulate::monitor`]).
+    fn monitor_sample(&mut self) {
+        let (points, q) = (&self.model.basis.points, &self.state.modal.q);
+        let monitors = self.settings.monitors.iter();
+        for (m, sums) in monitors.zip(&mut self.state.monitors) {
+            sums.add(m.direction.dot(&recombine(&points[m.point].rows, q)));
+        }
     }
 
     /// Opens the statistics window at the end of the current step (THEORY §11): an impact
@@ -160,6 +174,7 @@ impl Simulation<'_> {
             wall_time,
             termination: Termination::InProgress { step: state.step },
             target_met_at: state.statistics.target_met(),
+            monitors: self.monitor_statistics(),
         }
     }
 
@@ -167,6 +182,7 @@ impl Simulation<'_> {
     /// drained. `wall_time` is the caller's measure of the time spent stepping.
     pub fn finish(mut self, wall_time: f64, termination: Termination) -> RunResults {
         self.recorder.truncate();
+        let monitors = self.monitor_statistics();
         let dt = self.settings.dt;
         let mut state = self.state;
         let names = &self.work.names;
@@ -189,6 +205,16 @@ impl Simulation<'_> {
             stable_dt,
             wall_time,
             termination,
+            monitors,
         }
+    }
+
+    /// The monitors' statistics so far.
+    fn monitor_statistics(&self) -> Vec<MonitorStatistics> {
+        let monitors = self.settings.monitors.iter();
+        monitors
+            .zip(&self.state.monitors)
+            .map(|(m, sums)| sums.finish(m))
+            .collect()
     }
 }

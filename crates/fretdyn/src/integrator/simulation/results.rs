@@ -4,6 +4,7 @@
 use serde::Serialize;
 
 use crate::accumulate::energy::EnergyBalance;
+use crate::accumulate::monitor::MonitorStatistics;
 use crate::accumulate::recorder::Recorder;
 use crate::accumulate::statistics::{BlockStatistics, ContactStatistics, Impact};
 use crate::contact::tangential::SolverStatistics;
@@ -66,6 +67,9 @@ pub struct RunResults {
     /// End time of the step at which the target relative error was met
     /// (`[statistics] target_relative_error`), where the run stopped.
     pub target_met_at: Option<f64>,
+    /// The displacement monitors over the window's output samples
+    /// ([`crate::accumulate::monitor`]).
+    pub monitors: Vec<MonitorStatistics>,
 }
 
 impl RunResults {

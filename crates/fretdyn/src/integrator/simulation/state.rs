@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::contact_state::ContactState;
 use crate::accumulate::energy::EnergyBalance;
+use crate::accumulate::monitor::MonitorSums;
 use crate::accumulate::statistics::ContactStatisticsState;
 use crate::accumulate::wear_map::WearMap;
 use crate::contact::tangential::active_set::History;
@@ -50,6 +51,8 @@ pub struct State {
     /// Where the friction work was done, when tracked
     /// ([`super::Simulation::track_wear`]).
     pub(super) wear_map: Option<WearMap>,
+    /// The displacement monitors' sums over the window's output samples.
+    pub(super) monitors: Vec<MonitorSums>,
 }
 
 impl State {
@@ -91,6 +94,9 @@ impl State {
         };
         if !tangential {
             return Err(mismatch("tangential method"));
+        }
+        if self.monitors.len() != settings.monitors.len() {
+            return Err(mismatch("number of monitors"));
         }
         Ok(())
     }

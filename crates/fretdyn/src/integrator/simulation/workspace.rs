@@ -10,6 +10,7 @@ use nalgebra::Vector2;
 use super::contact_kinds;
 use super::contact_state::ContactState;
 use super::state::State;
+use crate::accumulate::monitor::MonitorSums;
 use crate::accumulate::energy::EnergyBalance;
 use crate::accumulate::statistics::ContactStatisticsState;
 use crate::contact::delassus::TangentialProblem;
@@ -274,6 +275,7 @@ impl<'m> Workspace<'m> {
             solver: SolverStatistics::default(),
             energy: EnergyBalance::default(),
             wear_map: None,
+            monitors: vec![MonitorSums::default(); settings.monitors.len()],
         }
     }
 }
