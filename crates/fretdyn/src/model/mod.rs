@@ -4,6 +4,7 @@
 //! everything a run needs except the numerical settings (THEORY §1, §2).
 
 pub mod equilibrium;
+pub mod preload;
 mod structures;
 
 pub use equilibrium::{StaticState, static_equilibrium};
