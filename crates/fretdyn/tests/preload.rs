@@ -420,3 +420,66 @@ fn a_study_key_path_sets_the_force_at_rest() {
         .expect("valid case");
     assert!(relative(applied(&case, 0).1, 40.0) <= 1e-9);
 }
+
+/// A two-body plane preloaded (THEORY §15): two point masses on springs `k_A`, `k_B` pressed
+/// together through a contact of stiffness `k` are three springs in series,
+/// `F = δ / (1/k + 1/k_A + 1/k_B)`; a force at rest `F` asks for `δ = F (1/k + 1/k_A + 1/k_B)`.
+#[test]
+fn a_two_body_plane_takes_a_preload_as_springs_in_series() {
+    use fretdyn::contact::friction::Coulomb;
+    use fretdyn::contact::obstacle::{Obstacle, Plane};
+    use fretdyn::contact::preload::{Preload, PreloadInput};
+    use fretdyn::contact::{Contact, NormalLaw};
+    use fretdyn::model::Model;
+    use fretdyn::model::preload::apply_preloads;
+    use fretdyn::structure::modal::ModalBasis;
+    use nalgebra::Vector3;
+    let (ma, mb, ka, kb, k) = (2.0, 3.0, 4e5, 9e5, 1e6);
+    let body = |m: f64, kx: f64, x: f64| {
+        let mut basis = ModalBasis::point_mass(m, "p", Vector3::new(x, 0.0, 0.0)).expect("mass");
+        basis.omega = vec![(kx / m).sqrt(), 1e3, 1e3];
+        basis.damping_ratio = vec![0.0; 3];
+        Model::new(basis)
+    };
+    let series = 1.0 / k + 1.0 / ka + 1.0 / kb;
+    for input in [PreloadInput::Interference(1e-4), PreloadInput::Force(30.0)] {
+        let mut model = Model::union(vec![
+            ("a".to_string(), body(ma, ka, 0.0)),
+            ("b".to_string(), body(mb, kb, -0.1)),
+        ])
+        .expect("two bodies");
+        // in relative coordinates x_A − x_B: the plane through the rest position, normal
+        // from B to A
+        let plane =
+            Plane::new(Vector3::new(0.1, 0.0, 0.0), Vector3::x(), 0.0, None, "o").expect("plane");
+        let mut contact = Contact::between(
+            "ab",
+            0,
+            1,
+            &model.basis.points,
+            [0.0, 0.0],
+            Obstacle::Plane(plane),
+            NormalLaw::new(k, 0.0, "n").expect("law"),
+            Coulomb::new(0.3, 0.3, "f").expect("friction"),
+        )
+        .expect("pair");
+        contact.preload = Some(Preload::new(input, "p").expect("preload"));
+        model.contacts.push(contact);
+        let state = apply_preloads(&mut model)
+            .expect("equilibrium")
+            .expect("a preload");
+        let (interference, force) = model.contacts[0].preload.and_then(|p| p.applied).unwrap();
+        let (d, f) = match input {
+            PreloadInput::Interference(d) => (d, d / series),
+            PreloadInput::Force(f) => (f * series, f),
+        };
+        assert!(relative(interference, d) <= 1e-12, "{interference} vs {d}");
+        assert!(relative(force, f) <= 1e-12, "{force} vs {f}");
+        // A pushed along +x by F/k_A, B along −x by F/k_B (q = √m u)
+        assert!(relative(state.q[0] / ma.sqrt(), f / ka) <= 1e-12);
+        assert!(relative(state.q[3] / mb.sqrt(), -f / kb) <= 1e-12);
+        assert_eq!(model.initial.q, state.q);
+        // applied once: a second call changes nothing
+        assert!(apply_preloads(&mut model).expect("nothing to do").is_none());
+    }
+}
