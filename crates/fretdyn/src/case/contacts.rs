@@ -1,6 +1,6 @@
 //! `[[contacts]]`: obstacles (plane, bi-plane, circle, polygon, cylinder), their motion, the
 //! normal law and the friction coefficients (THEORY §3, §4, §7, §8); with `other`, a
-//! two-body contact between two points (THEORY §15).
+//! two-body contact between two points (THEORY §15); a plane's `preload` (THEORY §16.1).
 
 use nalgebra::{Vector2, Vector3};
 use serde::Deserialize;
@@ -11,6 +11,7 @@ use super::wear::WearInput;
 use crate::contact::friction::Coulomb;
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::{BiPlane, Circle, Cylinder, Obstacle, Plane, Polygon};
+use crate::contact::preload::{Preload, PreloadInput};
 use crate::contact::{Contact, NormalLaw};
 use crate::error::{Error, Result, number};
 use crate::model::Model;
@@ -34,6 +35,35 @@ pub(super) struct ContactSection {
     friction: FrictionInput,
     /// Wear laws and scar geometry (docs/WEAR.md).
     wear: Option<WearInput>,
+    /// A plane pressed on the structure at rest (THEORY §16.1).
+    preload: Option<PreloadSection>,
+}
+
+/// `preload = { interference = I }` (m) or `preload = { force = F }` (N) of a plane contact.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct PreloadSection {
+    interference: Option<f64>,
+    force: Option<f64>,
+}
+
+impl PreloadSection {
+    /// The checked preload of the contact `field`, whose obstacle is `obstacle`.
+    fn build(&self, obstacle: &Obstacle, field: &str) -> Result<Preload> {
+        let pf = format!("{field}.preload");
+        let input = match (self.interference, self.force) {
+            (Some(i), None) => PreloadInput::Interference(i),
+            (None, Some(f)) => PreloadInput::Force(f),
+            _ => {
+                return Err(Error::invalid(
+                    pf,
+                    "give either interference (m: the plane pressed into the structure at rest) or force (N: the contact force at rest), not both",
+                ));
+            }
+        };
+        Preload::plane(obstacle, field)?;
+        Preload::new(input, &pf)
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -280,6 +310,9 @@ pub(super) fn build_contacts<'t>(
         };
         if let Some(m) = &c.motion {
             contact.motion = m.motion();
+        }
+        if let Some(pre) = &c.preload {
+            contact.preload = Some(pre.build(&contact.obstacle, &field)?);
         }
         contact.validate(contact.point_in(&model.basis.points), &field)?;
         // a pair's wear: A's scar against B, each side's radius (THEORY §15)

@@ -336,6 +336,9 @@ impl CaseFile {
                 ));
             }
         };
+        // a preloaded case starts at rest in its static equilibrium (THEORY §16.1)
+        let mut model = model;
+        crate::model::preload::apply_preloads(&mut model)?;
         let sections = SettingsSections {
             time: &self.time,
             tangential: &self.tangential,

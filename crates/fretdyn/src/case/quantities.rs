@@ -411,6 +411,20 @@ pub(super) const QUANTITIES: &[Quantity] = &[
         1e6,
     ),
     real(
+        &["contacts[*].preload.interference"],
+        "an interference",
+        "m",
+        0.0,
+        1e-2,
+    ),
+    real(
+        &["contacts[*].preload.force"],
+        "a contact force at rest",
+        "N",
+        0.0,
+        1e4,
+    ),
+    real(
         &[
             "contacts[*].friction.mu",
             "contacts[*].friction.mu_static",

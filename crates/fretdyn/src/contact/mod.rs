@@ -5,6 +5,7 @@
 //! Delassus operator (`delassus`, crate-private) solved by the [`tangential`] methods (THEORY §4, §7, §8).
 //!
 //! - [`obstacle`]: planes, bi-planes, circles, polygons: gap, normal, tangent frame;
+//! - [`preload`]: a plane pressed on the structure at rest (THEORY §16.1);
 //! - [`scar`]: the clearance a wear scar adds to an obstacle (THEORY §14.4);
 //! - [`frame_rows`]: the frame of a plane or bars projected on the modes (detection in one
 //!   dot product);
@@ -29,6 +30,7 @@ pub mod frame_rows;
 pub mod friction;
 pub mod motion;
 pub mod obstacle;
+pub mod preload;
 pub mod scar;
 pub mod tangential;
 
@@ -189,6 +191,9 @@ pub struct Contact {
     pub normal: NormalLaw,
     /// Static and dynamic friction coefficients.
     pub friction: Coulomb,
+    /// The preload of a plane pressed on the structure at rest (THEORY §16.1), `None` for
+    /// none (the common case); applied by `apply_preloads` of the model layer.
+    pub preload: Option<preload::Preload>,
 }
 
 impl Contact {
@@ -209,6 +214,7 @@ impl Contact {
             radius: 0.0,
             normal,
             friction,
+            preload: None,
         }
     }
 

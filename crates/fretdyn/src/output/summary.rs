@@ -134,7 +134,9 @@ fn structures(model: &crate::model::Model) -> serde_json::Value {
 /// (friction or normal, as its `work` says) and service time 0 (THEORY §14); a two-body
 /// contact also `tube_body` and `support_body`, the names of its points A and B. In a model of
 /// several structures or with two-body contacts, every contact also has its `point` and
-/// `other_point` (point B of a two-body contact, empty for an obstacle).
+/// `other_point` (point B of a two-body contact, empty for an obstacle). A preloaded contact
+/// has `preload_interference` (m) and `preload_force` (N), its plane's interference and its
+/// normal force at rest (THEORY §16.1).
 fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
     let mut contacts = json!(results.contacts);
     let model = &case.model;
@@ -154,6 +156,12 @@ fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_j
                 };
                 map.insert("point".into(), json!(name(Some(c.point))));
                 map.insert("other_point".into(), json!(name(c.other())));
+            }
+            // a preloaded plane (THEORY §16.1): the interference it was pressed by and its
+            // normal force at rest
+            if let Some((interference, force)) = model.contacts[k].preload.and_then(|p| p.applied) {
+                map.insert("preload_interference".into(), json!(interference));
+                map.insert("preload_force".into(), json!(force));
             }
             if let Some(w) = model.contact_wear(k) {
                 let (tube, support) = w.volume_rates(w.work.rate(stats), 0.0);
