@@ -5,9 +5,11 @@
 use nalgebra::{Vector2, Vector3};
 use serde::Deserialize;
 
+use super::flat_bar;
 use super::obstacle::ObstacleInput;
 use super::shared::{TubeModel, point_index, v3};
 use super::wear::WearInput;
+use crate::contact::flat_bar::FlatBar;
 use crate::contact::friction::Coulomb;
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::{BiPlane, Circle, Cylinder, Obstacle, Plane, Polygon};
@@ -34,6 +36,14 @@ pub(super) struct ContactSection {
     friction: FrictionInput,
     /// Wear laws and scar geometry (docs/WEAR.md).
     wear: Option<WearInput>,
+    /// A flat bar's width along the tube, m: the contact becomes `points_across` contacts
+    /// across it (`case/flat_bar.rs`).
+    width: Option<f64>,
+    /// The contact points across the bar's width (default 3: the edges and the middle).
+    points_across: Option<usize>,
+    /// The bar's face turned about the bar's length, degrees (> 0: nearer the tube on the
+    /// side of the tube's last node).
+    twist_deg: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -282,15 +292,61 @@ pub(super) fn build_contacts<'t>(
             contact.motion = m.motion();
         }
         contact.validate(contact.point_in(&model.basis.points), &field)?;
+        let bar = flat_bar_of(c, &field)?;
         // a pair's wear: A's scar against B, each side's radius (THEORY §15)
         let wear = c.wear.as_ref().map(|w| match pair {
             Some((_, radii)) => w.build_pair(radii, &c.obstacle, &field),
-            None => w.build(radius, &c.obstacle, &field),
+            None => w.build(radius, bar.as_ref(), &c.obstacle, &field),
         });
-        model.wear.push(wear.transpose()?);
-        model.contacts.push(contact);
+        let wear = wear.transpose()?;
+        let Some(bar) = bar else {
+            model.wear.push(wear);
+            model.contacts.push(contact);
+            continue;
+        };
+        for (sub, wear) in flat_bar::expand(contact, wear, bar, tube_of(pt), model, &field)? {
+            if bar.points > 1 {
+                if let Some(j) = names.insert(sub.name.clone(), k) {
+                    return Err(Error::invalid(
+                        format!("{field}.name"),
+                        format!(
+                            "'{}', one of its bar's points, is already the name of contacts[{j}]: rename one",
+                            sub.name
+                        ),
+                    ));
+                }
+            }
+            model.wear.push(wear);
+            model.contacts.push(sub);
+        }
     }
     Ok(())
+}
+
+/// The flat bar of the contact `c` if it gives a `width` (`points_across`, `twist_deg` need
+/// one); `field` names the contact.
+fn flat_bar_of(c: &ContactSection, field: &str) -> Result<Option<FlatBar>> {
+    let Some(width) = c.width else {
+        for (key, given) in [
+            ("points_across", c.points_across.is_some()),
+            ("twist_deg", c.twist_deg.is_some()),
+        ] {
+            if given {
+                return Err(Error::invalid(
+                    format!("{field}.{key}"),
+                    "is a flat bar's: give the bar's width (width = …, m) with it, or remove it",
+                ));
+            }
+        }
+        return Ok(None);
+    };
+    FlatBar::new(
+        width,
+        c.points_across.unwrap_or(flat_bar::DEFAULT_POINTS),
+        c.twist_deg.unwrap_or(0.0).to_radians(),
+        field,
+    )
+    .map(Some)
 }
 
 /// Point B and the radii `[R_A, R_B]` of the two-body contact `c` (THEORY §15), whose point A

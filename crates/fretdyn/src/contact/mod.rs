@@ -6,6 +6,7 @@
 //!
 //! - [`obstacle`]: planes, bi-planes, circles, polygons: gap, normal, tangent frame;
 //! - [`scar`]: the clearance a wear scar adds to an obstacle (THEORY §14.4);
+//! - [`flat_bar`]: a flat bar of finite width, possibly twisted: its points across the width;
 //! - [`frame_rows`]: the frame of a plane or bars projected on the modes (detection in one
 //!   dot product);
 //! - [`motion`]: the imposed motion of an obstacle (THEORY §8);
@@ -25,6 +26,7 @@ pub mod delassus;
 #[cfg(not(feature = "testing"))]
 #[allow(dead_code)]
 pub(crate) mod delassus;
+pub mod flat_bar;
 pub mod frame_rows;
 pub mod friction;
 pub mod motion;
@@ -189,6 +191,9 @@ pub struct Contact {
     pub normal: NormalLaw,
     /// Static and dynamic friction coefficients.
     pub friction: Coulomb,
+    /// Where the contact is across a flat bar's width (one of its points,
+    /// [`flat_bar`]), `None` for a contact that is not one of a bar's points.
+    pub across: Option<flat_bar::Across>,
 }
 
 impl Contact {
@@ -209,6 +214,7 @@ impl Contact {
             radius: 0.0,
             normal,
             friction,
+            across: None,
         }
     }
 

@@ -130,7 +130,9 @@ fn structures(model: &crate::model::Model) -> serde_json::Value {
 /// (friction or normal, as its `work` says) and service time 0 (THEORY §14); a two-body
 /// contact also `tube_body` and `support_body`, the names of its points A and B. In a model of
 /// several structures or with two-body contacts, every contact also has its `point` and
-/// `other_point` (point B of a two-body contact, empty for an obstacle).
+/// `other_point` (point B of a two-body contact, empty for an obstacle). One of a flat bar's
+/// points across its width (`width` on a contact) has its `axial_offset` `s_j` (m, along the
+/// tube's axis towards its last node) and its `width_share` `ω_j`.
 fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
     let mut contacts = json!(results.contacts);
     let model = &case.model;
@@ -150,6 +152,11 @@ fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_j
                 };
                 map.insert("point".into(), json!(name(Some(c.point))));
                 map.insert("other_point".into(), json!(name(c.other())));
+            }
+            if let Some(a) = model.contacts[k].across {
+                // one of a flat bar's points across its width: where (which edge)
+                map.insert("axial_offset".into(), json!(a.offset));
+                map.insert("width_share".into(), json!(a.weight));
             }
             if let Some(w) = model.contact_wear(k) {
                 let (tube, support) = w.volume_rates(w.work.rate(stats), 0.0);
