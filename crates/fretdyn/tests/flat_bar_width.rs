@@ -413,3 +413,72 @@ fn bad_bars_are_refused_naming_the_key() {
     let e = Case::from_toml_str(&text, std::path::Path::new(".")).unwrap_err();
     assert_eq!(e.field(), Some("contacts[0].width"), "{e}");
 }
+
+/// The U-bend of `examples/ubend.toml` with its hot-leg bars 25.4 mm wide, 3 points across,
+/// twisted by 0.2° (each edge 44 µm nearer than the middle on one side, of the 0.1 mm gap),
+/// wearing: the edges rattle, slide and do wear work, each point's strip wears by the laws, and the run's energy balance closes within the code's own limit
+/// (`MAX_RELATIVE_ERROR`, no warning) — the points' forces, friction included, do the work
+/// the balance books.
+#[test]
+fn a_u_bend_on_wide_twisted_bars_rattles_and_wears() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/ubend.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let hot = "tangent = [-0.707106781187, 0.0, 0.707106781187] }\n";
+    assert_eq!(text.matches(hot).count(), 1);
+    let text = text.replace(
+        hot,
+        &format!(
+            "{hot}width = 0.0254\npoints_across = 3\ntwist_deg = 0.2\nwear = {{ tube = {{ law = \"archard\", coefficient = 2e-14 }}, support = {{ law = \"archard\", coefficient = 1e-14 }}, scar = {{ type = \"flat_bar\" }} }}\n"
+        ),
+    );
+    let mut case = Case::from_toml_str(&text, path.parent().unwrap()).unwrap();
+    let names: Vec<&str> = case
+        .model
+        .contacts
+        .iter()
+        .map(|c| c.name.as_str())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "cold_leg_plate",
+            "hot_leg_plate",
+            "avb_cold",
+            "avb_hot[0]",
+            "avb_hot[1]",
+            "avb_hot[2]"
+        ]
+    );
+    case.settings.steps = 50_000;
+    let r = simulate(&case.model, &case.settings).unwrap();
+    assert!(
+        fretdyn::accumulate::energy::energy_warnings(&r.energy, case.settings.dt).is_empty(),
+        "{:?}",
+        r.energy
+    );
+    let mut total = 0.0;
+    for k in 3..6 {
+        let s = &r.contacts[k];
+        assert!(
+            s.wear_work_rate.is_finite() && s.wear_work_rate >= 0.0,
+            "{s:?}"
+        );
+        if k == 4 {
+            // the middle of a twisted face is farther than one of the edges on either side
+            continue;
+        }
+        assert!(s.impacts > 0 && s.slip_time_fraction > 0.0, "{s:?}");
+        assert!(s.wear_work_rate > 0.0, "{s:?}");
+        let w = case.model.contact_wear(k).unwrap();
+        let (tube, support) = w.volume_rates(s.wear_work_rate, 0.0);
+        assert!((tube - 2e-14 * s.wear_work_rate).abs() <= 1e-15 * tube && support > 0.0);
+        total += s.wear_work_rate;
+    }
+    eprintln!(
+        "avb_hot points: wear work rates {:?} W (sum {total:e}); energy balance {:e}",
+        (3..6)
+            .map(|k| r.contacts[k].wear_work_rate)
+            .collect::<Vec<_>>(),
+        r.energy.relative_error
+    );
+}
