@@ -3,8 +3,10 @@
 //! the [`Model`] the integrator steps — modal basis, contacts, loads and initial state,
 //! everything a run needs except the numerical settings (THEORY §1, §2).
 
+pub mod equilibrium;
 mod structures;
 
+pub use equilibrium::{StaticState, static_equilibrium};
 pub use structures::StructureRange;
 
 use nalgebra::DMatrix;
