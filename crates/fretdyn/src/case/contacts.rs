@@ -305,16 +305,16 @@ pub(super) fn build_contacts<'t>(
             continue;
         };
         for (sub, wear) in flat_bar::expand(contact, wear, bar, tube_of(pt), model, &field)? {
-            if bar.points > 1 {
-                if let Some(j) = names.insert(sub.name.clone(), k) {
-                    return Err(Error::invalid(
-                        format!("{field}.name"),
-                        format!(
-                            "'{}', one of its bar's points, is already the name of contacts[{j}]: rename one",
-                            sub.name
-                        ),
-                    ));
-                }
+            if bar.points > 1
+                && let Some(j) = names.insert(sub.name.clone(), k)
+            {
+                return Err(Error::invalid(
+                    format!("{field}.name"),
+                    format!(
+                        "'{}', one of its bar's points, is already the name of contacts[{j}]: rename one",
+                        sub.name
+                    ),
+                ));
             }
             model.wear.push(wear);
             model.contacts.push(sub);
