@@ -5,6 +5,7 @@
 
 use fretdyn::case::Case;
 use fretdyn::integrator::simulation::simulate;
+use fretdyn::model::static_equilibrium;
 use fretdyn::structure::modal::recombine;
 use fretdyn::wear::Scar;
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -175,10 +176,26 @@ fn final_state(case: &Case) -> (Vec<f64>, Vector3<f64>) {
         .map(|c| r.recorder.normal_force[[last, c]])
         .collect();
     let q: Vec<f64> = r.recorder.q.row(last).iter().copied().collect();
+    (forces, section(case, &q))
+}
+
+/// The mid-span section's `(u_x, u_z, θ_y)` at `q`.
+fn section(case: &Case, q: &[f64]) -> Vector3<f64> {
     let mid = &case.model.basis.points[case.model.basis.point_index("mid").unwrap()];
-    let u = recombine(&mid.rows, &q);
-    let theta = recombine(&mid.rotations, &q);
-    (forces, Vector3::new(u.x, u.z, theta.y))
+    let u = recombine(&mid.rows, q);
+    let theta = recombine(&mid.rotations, q);
+    Vector3::new(u.x, u.z, theta.y)
+}
+
+/// The same by the second method, the static equilibrium of the model on its contacts
+/// (`model::static_equilibrium`, Newton on the active set) under the modal force of `P`.
+fn static_state(case: &Case) -> (Vec<f64>, Vector3<f64>) {
+    let mid = &case.model.basis.points[case.model.basis.point_index("mid").unwrap()];
+    let p = case.model.basis.modes();
+    let force: Vec<f64> = (0..p).map(|i| -P * mid.rows[2 * p + i]).collect();
+    let s = static_equilibrium(&case.model, Some(&force)).unwrap();
+    let y = section(case, &s.q);
+    (s.forces, y)
 }
 
 /// Prints the largest differences from the closed form, relative to the largest force and
@@ -203,7 +220,8 @@ fn report(what: &str, f: &[f64], fe: &[f64], y: &Vector3<f64>, ye: &Vector3<f64>
 /// the tube, and the forces (each point's, and so their resultant and moment about the
 /// section) and the section's displacement and rotation are the closed form's to 1e-10
 /// (measured 8e-14: the transient has decayed by `e^{−αt/2} = e^{−120}`, what is left is
-/// round-off).
+/// round-off); the static equilibrium of the model (`model::static_equilibrium`), a second
+/// method, agrees with them.
 #[test]
 fn a_twisted_bar_carries_the_load_at_its_edge() {
     // the centre clearance that puts the +x edge at the tube's surface at rest
@@ -226,6 +244,11 @@ fn a_twisted_bar_carries_the_load_at_its_edge() {
     );
     let (forces, got_y) = final_state(&case);
     report("edge", &forces, &expected, &got_y, &y);
+    let (f2, y2) = static_state(&case);
+    report("edge, static equilibrium", &f2, &expected, &y2, &y);
+    for j in 0..n {
+        assert!((f2[j] - expected[j]).abs() <= 1e-10 * expected[n - 1]);
+    }
     for j in 0..n {
         assert!(
             (forces[j] - expected[j]).abs() <= 1e-10 * expected[n - 1],
@@ -273,6 +296,11 @@ fn a_slightly_twisted_bar_touches_over_its_width() {
     assert!(expected[n - 1] > expected[0]);
     let (forces, got_y) = final_state(&case);
     report("width", &forces, &expected, &got_y, &y);
+    let (f2, y2) = static_state(&case);
+    report("width, static equilibrium", &f2, &expected, &y2, &y);
+    for j in 0..n {
+        assert!((f2[j] - expected[j]).abs() <= 1e-10 * expected[n - 1]);
+    }
     let scale = expected.iter().cloned().fold(0.0, f64::max);
     for j in 0..n {
         assert!(
@@ -418,7 +446,7 @@ fn bad_bars_are_refused_naming_the_key() {
 /// twisted by 0.2° (each edge 44 µm nearer than the middle on one side, of the 0.1 mm gap),
 /// wearing: the edges rattle, slide and do wear work, each point's strip wears by the laws, and the run's energy balance closes within the code's own limit
 /// (`MAX_RELATIVE_ERROR`, no warning) — the points' forces, friction included, do the work
-/// the balance books.
+/// the balance books; `summary.json` gives each point's axial offset and share of the width.
 #[test]
 fn a_u_bend_on_wide_twisted_bars_rattles_and_wears() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/ubend.toml");
@@ -474,6 +502,19 @@ fn a_u_bend_on_wide_twisted_bars_rattles_and_wears() {
         assert!((tube - 2e-14 * s.wear_work_rate).abs() <= 1e-15 * tube && support > 0.0);
         total += s.wear_work_rate;
     }
+    // summary.json: which point is where across the width
+    let summary = fretdyn::output::summary::summary(&case, &r);
+    let half = 0.5 * 0.0254 * 0.2f64.to_radians().cos();
+    for (k, (s, w)) in [(-half, 0.25), (0.0, 0.5), (half, 0.25)]
+        .into_iter()
+        .enumerate()
+    {
+        let entry = &summary["contacts"][3 + k];
+        assert_eq!(entry["name"], format!("avb_hot[{k}]"));
+        assert!((entry["axial_offset"].as_f64().unwrap() - s).abs() < 1e-15);
+        assert_eq!(entry["width_share"].as_f64(), Some(w));
+    }
+    assert!(summary["contacts"][2].get("axial_offset").is_none());
     eprintln!(
         "avb_hot points: wear work rates {:?} W (sum {total:e}); energy balance {:e}",
         (3..6)
