@@ -1,6 +1,7 @@
 //! `[[contacts]]`: obstacles (plane, bi-plane, circle, polygon, cylinder), their motion, the
 //! normal law and the friction coefficients (THEORY §3, §4, §7, §8); with `other`, a
-//! two-body contact between two points (THEORY §15).
+//! two-body contact between two points (THEORY §15); with `width`, a flat bar's points across
+//! its width (`flat_bar.rs`).
 
 use nalgebra::{Vector2, Vector3};
 use serde::Deserialize;
@@ -106,7 +107,8 @@ pub(super) struct FrictionInput {
 /// `[[contacts]]`: each contact's point, obstacle (and its motion), normal law and friction
 /// coefficients (THEORY §3, §4, §7, §8), or, with `other`, the two points of a two-body
 /// contact (THEORY §15). `tube_of` gives the tube structure a point (its index) belongs to,
-/// if it is one: the radii are checked against its outer radius.
+/// if it is one: the radii are checked against its outer radius, and a flat bar's `width`
+/// lies along its axis (its points across the width, `case/flat_bar.rs`).
 pub(super) fn build_contacts<'t>(
     contacts: &[ContactSection],
     tube_of: &dyn Fn(usize) -> Option<&'t TubeModel>,
