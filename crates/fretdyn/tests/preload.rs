@@ -391,6 +391,12 @@ fn bad_preloads_are_refused_by_key() {
             "contacts[0].preload",
             "plane obstacles",
         ),
+        (
+            // a bar with a width is one face: a force would not say how it spreads
+            plane("force = 1.0").replace("friction =", "width = 0.02\nfriction ="),
+            "contacts[0].preload.force",
+            "interference",
+        ),
     ] {
         let err = Case::from_toml_str(&case_text(&contacts, 1e-5), Path::new("."))
             .expect_err("refused");

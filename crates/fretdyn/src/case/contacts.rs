@@ -1,13 +1,16 @@
 //! `[[contacts]]`: obstacles (plane, bi-plane, circle, polygon, cylinder), their motion, the
 //! normal law and the friction coefficients (THEORY §3, §4, §7, §8); with `other`, a
-//! two-body contact between two points (THEORY §15); a plane's `preload` (THEORY §16.1).
+//! two-body contact between two points (THEORY §15); a plane's `preload` (THEORY §16.1); with
+//! `width`, a flat bar's points across its width (`flat_bar.rs`).
 
 use nalgebra::{Vector2, Vector3};
 use serde::Deserialize;
 
+use super::flat_bar;
 use super::obstacle::ObstacleInput;
 use super::shared::{TubeModel, point_index, v3};
 use super::wear::WearInput;
+use crate::contact::flat_bar::FlatBar;
 use crate::contact::friction::Coulomb;
 use crate::contact::motion::Motion;
 use crate::contact::obstacle::{BiPlane, Circle, Cylinder, Obstacle, Plane, Polygon};
@@ -35,6 +38,14 @@ pub(super) struct ContactSection {
     friction: FrictionInput,
     /// Wear laws and scar geometry (docs/WEAR.md).
     wear: Option<WearInput>,
+    /// A flat bar's width along the tube, m: the contact becomes `points_across` contacts
+    /// across it (`case/flat_bar.rs`).
+    width: Option<f64>,
+    /// The contact points across the bar's width (default 3: the edges and the middle).
+    points_across: Option<usize>,
+    /// The bar's face turned about the bar's length, degrees (> 0: nearer the tube on the
+    /// side of the tube's last node).
+    twist_deg: Option<f64>,
     /// A plane pressed on the structure at rest (THEORY §16.1).
     preload: Option<PreloadSection>,
 }
@@ -126,7 +137,8 @@ pub(super) struct FrictionInput {
 /// `[[contacts]]`: each contact's point, obstacle (and its motion), normal law and friction
 /// coefficients (THEORY §3, §4, §7, §8), or, with `other`, the two points of a two-body
 /// contact (THEORY §15). `tube_of` gives the tube structure a point (its index) belongs to,
-/// if it is one: the radii are checked against its outer radius.
+/// if it is one: the radii are checked against its outer radius, and a flat bar's `width`
+/// lies along its axis (its points across the width, `case/flat_bar.rs`).
 pub(super) fn build_contacts<'t>(
     contacts: &[ContactSection],
     tube_of: &dyn Fn(usize) -> Option<&'t TubeModel>,
@@ -315,15 +327,70 @@ pub(super) fn build_contacts<'t>(
             contact.preload = Some(pre.build(&contact.obstacle, &field)?);
         }
         contact.validate(contact.point_in(&model.basis.points), &field)?;
+        let bar = flat_bar_of(c, &field)?;
         // a pair's wear: A's scar against B, each side's radius (THEORY §15)
         let wear = c.wear.as_ref().map(|w| match pair {
             Some((_, radii)) => w.build_pair(radii, &c.obstacle, &field),
-            None => w.build(radius, &c.obstacle, &field),
+            None => w.build(radius, bar.as_ref(), &c.obstacle, &field),
         });
-        model.wear.push(wear.transpose()?);
-        model.contacts.push(contact);
+        let wear = wear.transpose()?;
+        if let (Some(bar), Some(pre)) = (&bar, &contact.preload)
+            && bar.points > 1
+            && matches!(pre.input, PreloadInput::Force(_))
+        {
+            return Err(Error::invalid(
+                format!("{field}.preload.force"),
+                "a bar with a width is pressed as one face: give its preload as an interference (m, every point of the face moved alike); a force at rest would not say how it spreads over the width",
+            ));
+        }
+        let Some(bar) = bar else {
+            model.wear.push(wear);
+            model.contacts.push(contact);
+            continue;
+        };
+        for (sub, wear) in flat_bar::expand(contact, wear, bar, tube_of(pt), model, &field)? {
+            if bar.points > 1
+                && let Some(j) = names.insert(sub.name.clone(), k)
+            {
+                return Err(Error::invalid(
+                    format!("{field}.name"),
+                    format!(
+                        "'{}', one of its bar's points, is already the name of contacts[{j}]: rename one",
+                        sub.name
+                    ),
+                ));
+            }
+            model.wear.push(wear);
+            model.contacts.push(sub);
+        }
     }
     Ok(())
+}
+
+/// The flat bar of the contact `c` if it gives a `width` (`points_across`, `twist_deg` need
+/// one); `field` names the contact.
+fn flat_bar_of(c: &ContactSection, field: &str) -> Result<Option<FlatBar>> {
+    let Some(width) = c.width else {
+        for (key, given) in [
+            ("points_across", c.points_across.is_some()),
+            ("twist_deg", c.twist_deg.is_some()),
+        ] {
+            if given {
+                return Err(Error::invalid(
+                    format!("{field}.{key}"),
+                    "is a flat bar's: give the bar's width (width = …, m) with it, or remove it",
+                ));
+            }
+        }
+        return Ok(None);
+    };
+    FlatBar::new(
+        width,
+        c.points_across.unwrap_or(flat_bar::DEFAULT_POINTS),
+        c.twist_deg.unwrap_or(0.0).to_radians(),
+        field,
+    )
+    .map(Some)
 }
 
 /// Point B and the radii `[R_A, R_B]` of the two-body contact `c` (THEORY §15), whose point A

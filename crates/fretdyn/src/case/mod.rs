@@ -24,6 +24,7 @@
 
 mod contacts;
 pub mod fingerprint;
+mod flat_bar;
 mod flow;
 pub mod key_path;
 mod life;
@@ -406,6 +407,8 @@ impl CaseFile {
                 .and_then(|(_, t)| t.as_deref())
         };
         build_contacts(&self.contacts, &tube_of, &mut model)?;
+        // the points across a bar's width (case/flat_bar.rs) have no abscissa of their own
+        point_abscissae.resize(model.basis.points.len(), None);
         model.validate()?;
         Ok((model, point_abscissae))
     }

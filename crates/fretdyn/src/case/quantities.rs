@@ -435,6 +435,16 @@ pub(super) const QUANTITIES: &[Quantity] = &[
         0.0,
         2.0,
     ),
+    // a flat bar's width and its points across it (case/flat_bar.rs)
+    real(&["contacts[*].width"], "a bar's width", "m", 1e-3, 0.2),
+    Quantity {
+        keys: &["contacts[*].points_across"],
+        kind: Kind::Whole { min: 1 },
+        what: "a number of contact points across a bar's width",
+        unit: "",
+        plausible: Some((1.0, 21.0)),
+        limit: None,
+    },
     // a contact's wear (docs/WEAR.md)
     real(
         &[

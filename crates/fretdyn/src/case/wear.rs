@@ -4,6 +4,7 @@
 use serde::Deserialize;
 
 use super::obstacle::ObstacleInput;
+use crate::contact::flat_bar::FlatBar;
 use crate::error::{Error, Result, number};
 use crate::wear::{ContactWear, HoleScar, Scar, WearLaw, WearWork};
 
@@ -55,9 +56,10 @@ enum ShapeInput {
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 enum ScarInput {
     FlatBar {
-        width: f64,
-        #[serde(default)]
-        tilt_deg: f64,
+        /// Required unless the contact gives the bar's `width` (then equal to it).
+        width: Option<f64>,
+        /// 0 by default, or the contact's `twist_deg` (then equal to its magnitude).
+        tilt_deg: Option<f64>,
         tube_radius: Option<f64>,
     },
     DrilledHole {
@@ -105,16 +107,18 @@ impl LawInput {
 }
 
 impl WearInput {
-    /// The contact's wear: `radius` is the contact's `radius` key (0 if absent), `obstacle`
-    /// its obstacle (the scar must suit it; a drilled hole takes its clearance), `field` the
-    /// contact (`contacts[k]`).
+    /// The contact's wear: `radius` is the contact's `radius` key (0 if absent), `bar` its
+    /// flat bar if it gives a width (a `flat_bar` scar takes its width and its twist as the
+    /// tilt), `obstacle` its obstacle (the scar must suit it; a drilled hole takes its
+    /// clearance), `field` the contact (`contacts[k]`).
     pub(super) fn build(
         &self,
         radius: f64,
+        bar: Option<&FlatBar>,
         obstacle: &ObstacleInput,
         field: &str,
     ) -> Result<ContactWear> {
-        self.build_for(radius, None, obstacle, field)
+        self.build_for(radius, None, bar, obstacle, field)
     }
 
     /// The wear of a two-body contact (THEORY §15, [`ContactWear`]): `tube` is the law of
@@ -129,7 +133,7 @@ impl WearInput {
         obstacle: &ObstacleInput,
         field: &str,
     ) -> Result<ContactWear> {
-        self.build_for(radii[0], Some(radii[1]), obstacle, field)
+        self.build_for(radii[0], Some(radii[1]), None, obstacle, field)
     }
 
     /// [`Self::build`] with `other`, side B's radius of a two-body contact (`None` for a
@@ -138,6 +142,7 @@ impl WearInput {
         &self,
         radius: f64,
         other: Option<f64>,
+        bar: Option<&FlatBar>,
         obstacle: &ObstacleInput,
         field: &str,
     ) -> Result<ContactWear> {
@@ -203,11 +208,14 @@ impl WearInput {
         let scar = match self.scar {
             ScarInput::FlatBar {
                 width, tilt_deg, ..
-            } => Scar::FlatBar {
-                tube_radius,
-                width,
-                tilt: tilt_deg.to_radians(),
-            },
+            } => {
+                let (width, tilt) = flat_bar_scar(width, tilt_deg, bar, &sf)?;
+                Scar::FlatBar {
+                    tube_radius,
+                    width,
+                    tilt,
+                }
+            }
             ScarInput::DrilledHole {
                 thickness, shape, ..
             } => {
@@ -286,6 +294,48 @@ impl WearInput {
     }
 }
 
+/// A flat-bar scar's width and tilt (rad): as written, or the contact's bar's width and the
+/// magnitude of its twist (both given, they must agree: the scar is the bar's); `sf` names
+/// the scar.
+fn flat_bar_scar(
+    width: Option<f64>,
+    tilt_deg: Option<f64>,
+    bar: Option<&FlatBar>,
+    sf: &str,
+) -> Result<(f64, f64)> {
+    let Some(bar) = bar else {
+        let Some(width) = width else {
+            return Err(Error::invalid(
+                format!("{sf}.width"),
+                "a flat_bar scar needs the bar's width along the tube, m (or give the contact's width)",
+            ));
+        };
+        return Ok((width, tilt_deg.unwrap_or(0.0).to_radians()));
+    };
+    if let Some(w) = width.filter(|w| *w != bar.width) {
+        return Err(Error::invalid(
+            format!("{sf}.width"),
+            format!(
+                "{} m differs from the contact's width {} m: give the bar's width once",
+                number(w),
+                number(bar.width)
+            ),
+        ));
+    }
+    let twist = bar.twist.abs();
+    if let Some(t) = tilt_deg.filter(|t| t.to_radians() != twist) {
+        return Err(Error::invalid(
+            format!("{sf}.tilt_deg"),
+            format!(
+                "{} differs from the magnitude of the contact's twist_deg {}: a bar's scar is tilted by its twist (remove tilt_deg)",
+                number(t),
+                number(twist.to_degrees())
+            ),
+        ));
+    }
+    Ok((bar.width, twist))
+}
+
 fn obstacle_name(o: &ObstacleInput) -> &'static str {
     match o {
         ObstacleInput::Plane { .. } => "plane",
@@ -329,7 +379,7 @@ mod tests {
         );
         assert_eq!(w.tube, WearLaw::Archard { coefficient: 2e-15 });
         assert_eq!(w.support, WearLaw::Archard { coefficient: 1e-15 });
-        let e = tube.build(0.01, &plane(), "c").unwrap_err();
+        let e = tube.build(0.01, None, &plane(), "c").unwrap_err();
         assert_eq!(e.field(), Some("c.wear.scar.other_radius"));
         let e = tube.build_pair([0.01, 0.0], &plane(), "c").unwrap_err();
         assert_eq!(e.field(), Some("c.wear.scar.other_radius"));

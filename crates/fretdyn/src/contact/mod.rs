@@ -7,6 +7,7 @@
 //! - [`obstacle`]: planes, bi-planes, circles, polygons: gap, normal, tangent frame;
 //! - [`preload`]: a plane pressed on the structure at rest (THEORY §16.1);
 //! - [`scar`]: the clearance a wear scar adds to an obstacle (THEORY §14.4);
+//! - [`flat_bar`]: a flat bar of finite width, possibly twisted: its points across the width;
 //! - [`frame_rows`]: the frame of a plane or bars projected on the modes (detection in one
 //!   dot product);
 //! - [`motion`]: the imposed motion of an obstacle (THEORY §8);
@@ -26,6 +27,7 @@ pub mod delassus;
 #[cfg(not(feature = "testing"))]
 #[allow(dead_code)]
 pub(crate) mod delassus;
+pub mod flat_bar;
 pub mod frame_rows;
 pub mod friction;
 pub mod motion;
@@ -194,6 +196,9 @@ pub struct Contact {
     /// The preload of a plane pressed on the structure at rest (THEORY §16.1), `None` for
     /// none (the common case); applied by `apply_preloads` of the model layer.
     pub preload: Option<preload::Preload>,
+    /// Where the contact is across a flat bar's width (one of its points,
+    /// [`flat_bar`]), `None` for a contact that is not one of a bar's points.
+    pub across: Option<flat_bar::Across>,
 }
 
 impl Contact {
@@ -215,6 +220,7 @@ impl Contact {
             normal,
             friction,
             preload: None,
+            across: None,
         }
     }
 

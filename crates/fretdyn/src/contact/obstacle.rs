@@ -299,6 +299,16 @@ impl BiPlane {
         })
     }
 
+    /// Reference point `x0` of the mid-plane.
+    pub fn origin(&self) -> Vector3<f64> {
+        self.origin
+    }
+
+    /// Clearance `gap` on each side, m.
+    pub fn gap(&self) -> f64 {
+        self.gap
+    }
+
     #[inline]
     fn frame(&self, x: &Vector3<f64>) -> ContactFrame {
         let s = (x - self.origin).dot(&self.normal);

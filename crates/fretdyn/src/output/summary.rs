@@ -136,7 +136,9 @@ fn structures(model: &crate::model::Model) -> serde_json::Value {
 /// several structures or with two-body contacts, every contact also has its `point` and
 /// `other_point` (point B of a two-body contact, empty for an obstacle). A preloaded contact
 /// has `preload_interference` (m) and `preload_force` (N), its plane's interference and its
-/// normal force at rest (THEORY §16.1).
+/// normal force at rest (THEORY §16.1). One of a flat bar's points across its width (`width` on a
+/// contact) has its `axial_offset` `s_j` (m, along the tube's axis towards its last node) and its
+/// `width_share` `ω_j`.
 fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_json::Value {
     let mut contacts = json!(results.contacts);
     let model = &case.model;
@@ -162,6 +164,11 @@ fn contacts_with_wear(case: &crate::case::Case, results: &RunResults) -> serde_j
             if let Some((interference, force)) = model.contacts[k].preload.and_then(|p| p.applied) {
                 map.insert("preload_interference".into(), json!(interference));
                 map.insert("preload_force".into(), json!(force));
+            }
+            if let Some(a) = model.contacts[k].across {
+                // one of a flat bar's points across its width: where (which edge)
+                map.insert("axial_offset".into(), json!(a.offset));
+                map.insert("width_share".into(), json!(a.weight));
             }
             if let Some(w) = model.contact_wear(k) {
                 let (tube, support) = w.volume_rates(w.work.rate(stats), 0.0);
