@@ -171,9 +171,9 @@ fn determinant(spans: &[f64], beta: f64) -> f64 {
     put(row, 0, at0(2), 1.0);
     put(row + 1, n - 1, at_l(spans[n - 1], 2), 1.0);
     row += 2;
-    for i in 0..n - 1 {
+    for (i, l) in spans.iter().enumerate().take(n - 1) {
         for k in [1, 2] {
-            put(row, i, at_l(spans[i], k), 1.0);
+            put(row, i, at_l(*l, k), 1.0);
             put(row, i + 1, at0(k), -1.0);
             row += 1;
         }
@@ -302,7 +302,7 @@ fn support_active_ubend_avb_held_out_of_plane_raises_only_out_of_plane_modes() {
     // symmetry: every mode is in one plane
     for m in &r.modes {
         let q = m.out_of_plane_share.unwrap();
-        assert!(q < 1e-9 || q > 1.0 - 1e-9, "{m:?}");
+        assert!(!(1e-9..=1.0 - 1e-9).contains(&q), "{m:?}");
     }
     let (free_in, free_out) = (
         of(SUPPORT_INACTIVE, Plane::InPlane),
