@@ -120,7 +120,8 @@ enum Command {
         shown: usize,
     },
     /// Connors fluid-elastic stability check of every mode of a case with a [flow] section
-    /// (docs/FLOW.md): frequency, damping, effective and critical velocities, their ratio;
+    /// (docs/FLOW.md), and of the modes of each support condition of its [stability]:
+    /// frequency, damping, effective and critical velocities, their ratio, the mode's plane;
     /// printed and written as stability.json and stability.csv.
     Stability {
         /// Case file (TOML) with [flow] and [[flow.zones]].

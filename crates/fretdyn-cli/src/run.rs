@@ -85,20 +85,78 @@ fn load(path: &Path) -> Result<Case, Failure> {
     {
         errln!("warning: {}: {w}", path.display());
     }
-    if let Some(report) = case.stability() {
-        for m in report.unstable() {
-            errln!(
-                "warning: {}: mode {} ({:.4} Hz) is above the Connors critical velocity: U_eff/U_c = {:.4} (U_eff = {:.4} m/s, U_c = {:.4} m/s; fluid-elastic instability expected, see fretdyn stability)",
-                path.display(),
-                m.mode,
-                m.frequency_hz,
-                m.ratio.unwrap_or(f64::NAN),
-                m.effective_velocity,
-                m.critical_velocity
-            );
+    if let Some(report) = case.stability_checks() {
+        let report = report.map_err(|e| Failure::input(e.in_file(path)))?;
+        for (unstable, line) in connors_summary(&report) {
+            if unstable {
+                errln!(
+                    "warning: {}: Connors: {line}; fluid-elastic instability expected, see fretdyn stability",
+                    path.display()
+                );
+            }
         }
     }
     Ok(case)
+}
+
+/// One line per support condition of a Connors check: per plane (in-plane, out-of-plane,
+/// mixed; all modes together when the structure has no plane) how many modes are above the
+/// critical velocity, with the largest ratio, its mode and frequency:
+/// "condition `support_inactive`: in-plane: 3 of 12 modes above the critical velocity
+/// (largest U_eff/U_c = 2.1, mode 4, 12.3 Hz); out-of-plane: none of 18 modes above", and
+/// whether a mode of the condition is above.
+pub fn connors_summary(report: &fretdyn::loads::flow::StabilityReport) -> Vec<(bool, String)> {
+    use fretdyn::loads::flow::{ModeStability, Plane};
+    let mut conditions: Vec<&str> = Vec::new();
+    for m in &report.modes {
+        if !conditions.contains(&m.condition.as_str()) {
+            conditions.push(&m.condition);
+        }
+    }
+    let planes = [
+        (Some(Plane::InPlane), "in-plane"),
+        (Some(Plane::OutOfPlane), "out-of-plane"),
+        (Some(Plane::Mixed), "mixed"),
+        (None, "all modes"),
+    ];
+    conditions
+        .iter()
+        .map(|condition| {
+            let parts: Vec<String> = planes
+                .iter()
+                .filter_map(|(plane, label)| {
+                    let modes: Vec<&ModeStability> = report
+                        .modes
+                        .iter()
+                        .filter(|m| m.condition == *condition && m.plane == *plane)
+                        .collect();
+                    if modes.is_empty() {
+                        return None;
+                    }
+                    let unstable: Vec<&&ModeStability> =
+                        modes.iter().filter(|m| m.unstable()).collect();
+                    Some(match unstable.iter().max_by(|a, b| {
+                        a.ratio.unwrap_or(0.0).total_cmp(&b.ratio.unwrap_or(0.0))
+                    }) {
+                        None => format!("{label}: none of {} modes above", modes.len()),
+                        Some(w) => format!(
+                            "{label}: {} of {} modes above the critical velocity (largest U_eff/U_c = {:.4}, mode {}, {:.4} Hz)",
+                            unstable.len(),
+                            modes.len(),
+                            w.ratio.unwrap_or(f64::NAN),
+                            w.mode,
+                            w.frequency_hz
+                        ),
+                    })
+                })
+                .collect();
+            let any = report
+                .modes
+                .iter()
+                .any(|m| m.condition == *condition && m.unstable());
+            (any, format!("condition `{condition}`: {}", parts.join("; ")))
+        })
+        .collect()
 }
 
 /// Refuses a case that cannot start, before anything is written: what a run checks as it

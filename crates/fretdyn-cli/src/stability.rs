@@ -1,6 +1,8 @@
 //! `fretdyn stability CASE.toml`: the Connors fluid-elastic stability check of every mode of a
-//! case with a `[flow]` section (docs/FLOW.md), printed and written as `stability.json` and
-//! `stability.csv`. The library computes ([`fretdyn::Case::stability`]); this prints.
+//! case with a `[flow]` section (docs/FLOW.md) — the basis's modes (supports inactive), then
+//! those of each support condition of `[stability]` — printed and written as
+//! `stability.json` and `stability.csv`. The library computes
+//! ([`fretdyn::Case::stability_checks`]); this prints.
 
 use std::path::{Path, PathBuf};
 
@@ -16,7 +18,7 @@ pub fn main(path: &Path, output: Option<PathBuf>) -> Result<(), Failure> {
     for w in &case.warnings {
         errln!("warning: {w}");
     }
-    let Some(report) = case.stability() else {
+    let Some(report) = case.stability_checks() else {
         if !case.model.structures.is_empty() {
             return Err(Failure::input(format!(
                 "{}: structures: the Connors check of a case of several structures is not supported yet: check each structure in a case of its own ([structure] with its [flow])",
@@ -28,6 +30,7 @@ pub fn main(path: &Path, output: Option<PathBuf>) -> Result<(), Failure> {
             path.display()
         )));
     };
+    let report = report.map_err(|e| Failure::input(e.in_file(path)))?;
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -58,8 +61,17 @@ fn print(title: &str, report: &StabilityReport) -> Result<(), Failure> {
         report.diameter,
         report.mass_per_length
     )?;
+    let width = report
+        .modes
+        .iter()
+        .map(|m| m.condition.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max("condition".len());
     outln!(
-        "{:>5} {:>12} {:>9} {:>12} {:>10} {:>10} {:>8}  zone (ρ_ref)",
+        "{:<width$} {:<12} {:>5} {:>12} {:>9} {:>12} {:>10} {:>10} {:>8}  zone (ρ_ref)",
+        "condition",
+        "plane",
         "mode",
         "f (Hz)",
         "ζ",
@@ -73,7 +85,9 @@ fn print(title: &str, report: &StabilityReport) -> Result<(), Failure> {
             .ratio
             .map_or_else(|| "-".to_string(), |r| format!("{r:.4}"));
         outln!(
-            "{:>5} {:>12.4} {:>9.4} {:>12.4} {:>10.4} {:>10} {:>8}  {} ({:.4} kg/m³)",
+            "{:<width$} {:<12} {:>5} {:>12.4} {:>9.4} {:>12.4} {:>10.4} {:>10} {:>8}  {} ({:.4} kg/m³)",
+            m.condition,
+            m.plane.map_or("-", |p| p.name()),
             m.mode,
             m.frequency_hz,
             m.damping_ratio,
@@ -85,9 +99,8 @@ fn print(title: &str, report: &StabilityReport) -> Result<(), Failure> {
             m.reference_density
         )?;
     }
-    let unstable = report.unstable().count();
-    outln!(
-        "{unstable} of {} modes above the Connors critical velocity",
-        report.modes.len()
-    )
+    for (_, line) in crate::run::connors_summary(report) {
+        outln!("{line}")?;
+    }
+    Ok(())
 }

@@ -905,8 +905,9 @@ fn json_problems(path: &Path, name: &str, unbounded_dt: bool, problems: &mut Vec
                 "wear_work_rate_se",
                 "contact",
             ],
-            // U_eff = U_c = 0, or ∞ for an undamped mode (JSON has no infinity)
-            "stability.json" => &["ratio"],
+            // U_eff = U_c = 0, or ∞ for an undamped mode (JSON has no infinity); no plane
+            // (a straight tube)
+            "stability.json" => &["ratio", "plane", "out_of_plane_share"],
             // what the samples cannot give (empty cells of percentiles.csv), or ∞
             "percentiles.json" => &[
                 "estimate",

@@ -384,7 +384,9 @@ fn run_warns_when_a_mode_is_above_the_critical_velocity() {
     let (slow, fast) = (0.5, 4.0);
     assert!(effective(slow, 1.0) < critical(1.0));
     assert!(effective(fast, 1.0) > critical(1.0) && effective(fast, 2.0) < critical(2.0));
-    for (u, warnings) in [(slow, 0), (fast, 2)] {
+    // one warning per support condition (here only the basis's: a straight tube has no
+    // plane, its modes are counted together), naming the worst mode
+    for (u, warnings) in [(slow, 0), (fast, 1)] {
         std::fs::write(s.0.join("case.toml"), case(u)).unwrap();
         let out = fretdyn(
             &["run", "case.toml", "-o", "out", "--quiet", "--no-plots"],
@@ -392,14 +394,16 @@ fn run_warns_when_a_mode_is_above_the_critical_velocity() {
         );
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{stderr}");
-        let lines: Vec<&str> = stderr
-            .lines()
-            .filter(|l| l.contains("Connors critical velocity"))
-            .collect();
+        let lines: Vec<&str> = stderr.lines().filter(|l| l.contains("Connors")).collect();
         assert_eq!(lines.len(), warnings, "{stderr}");
-        for (l, mode) in lines.iter().zip(["mode 1 ", "mode 2 "]) {
-            assert!(l.starts_with("warning: case.toml: "), "{l}");
-            assert!(l.contains(mode), "{l}");
+        for l in &lines {
+            assert!(
+                l.starts_with(
+                    "warning: case.toml: Connors: condition `support_inactive`: all modes: 2 of "
+                ),
+                "{l}"
+            );
+            assert!(l.contains("mode 1, ") || l.contains("mode 2, "), "{l}");
         }
         let _ = std::fs::remove_dir_all(s.0.join("out"));
     }

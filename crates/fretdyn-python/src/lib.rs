@@ -654,31 +654,37 @@ fn coordinates<'py>(py: Python<'py>, case: &Case) -> PyResult<(Bound<'py, PyDict
 }
 
 /// The Connors fluid-elastic stability check of every mode of a case with a `[flow]` section
-/// (docs/FLOW.md; `fretdyn stability`): a dict of numpy arrays, one per column of
-/// `stability.csv` (`mode`, `frequency_hz`, `damping_ratio`, `reference_density`,
+/// (docs/FLOW.md; `fretdyn stability`): the basis's modes (condition `support_inactive`),
+/// then those of each support condition of `[stability]`. A dict of numpy arrays, one per
+/// column of `stability.csv` (`mode`, `frequency_hz`, `damping_ratio`, `reference_density`,
 /// `effective_velocity`, `critical_velocity`, `ratio`: NaN where undefined, inf for an
-/// undamped mode in a flow), `reference_zone` (list of str) and the scalars
-/// `connors_constant`, `diameter`, `mass_per_length`. A case without `[flow]` is a
-/// FretdynError with the CLI's message.
+/// undamped mode in a flow; `out_of_plane_share`: NaN when the structure has no plane),
+/// `reference_zone`, `condition` and `plane` (`in_plane`, `out_of_plane`, `mixed`, or ""
+/// without a plane) as lists of str, and the scalars `connors_constant`, `diameter`,
+/// `mass_per_length`. A case without `[flow]` is a FretdynError with the CLI's message.
 #[pyfunction]
 fn stability<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> {
-    let Some(report) = case.inner.stability() else {
+    let Some(report) = case.inner.stability_checks() else {
         return Err(FretdynError::new_err(
             "flow: the case has no [flow] section: add one with its [[flow.zones]] (docs/FLOW.md)",
         ));
     };
+    let report = report.map_err(err)?;
     let out = PyDict::new(py);
     let modes = &report.modes;
     let mode: Vec<i64> = modes.iter().map(|m| m.mode as i64).collect();
     out.set_item("mode", PyArray1::from_vec(py, mode))?;
     type Column = fn(&fretdyn::loads::flow::ModeStability) -> f64;
-    let columns: [(&str, Column); 6] = [
+    let columns: [(&str, Column); 7] = [
         ("frequency_hz", |m| m.frequency_hz),
         ("damping_ratio", |m| m.damping_ratio),
         ("reference_density", |m| m.reference_density),
         ("effective_velocity", |m| m.effective_velocity),
         ("critical_velocity", |m| m.critical_velocity),
         ("ratio", |m| m.ratio.unwrap_or(f64::NAN)),
+        ("out_of_plane_share", |m| {
+            m.out_of_plane_share.unwrap_or(f64::NAN)
+        }),
     ];
     for (key, value) in columns {
         out.set_item(
@@ -688,6 +694,13 @@ fn stability<'py>(py: Python<'py>, case: &Case) -> PyResult<Bound<'py, PyDict>> 
     }
     let zones: Vec<String> = modes.iter().map(|m| m.reference_zone.clone()).collect();
     out.set_item("reference_zone", zones)?;
+    let conditions: Vec<String> = modes.iter().map(|m| m.condition.clone()).collect();
+    out.set_item("condition", conditions)?;
+    let planes: Vec<&str> = modes
+        .iter()
+        .map(|m| m.plane.map_or("", |p| p.name()))
+        .collect();
+    out.set_item("plane", planes)?;
     out.set_item("connors_constant", report.connors_constant)?;
     out.set_item("diameter", report.diameter)?;
     out.set_item("mass_per_length", report.mass_per_length)?;

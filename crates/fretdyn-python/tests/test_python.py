@@ -322,7 +322,7 @@ def test_ctrl_c_stops_a_run_with_keyboard_interrupt(tmp_path):
 
 STABILITY_COLUMNS = [
     "mode", "frequency_hz", "damping_ratio", "reference_density", "effective_velocity",
-    "critical_velocity", "ratio",
+    "critical_velocity", "ratio", "out_of_plane_share",
 ]
 
 
@@ -335,7 +335,8 @@ def test_stability_equals_the_cli_bit_for_bit(tmp_path):
     for given in (case, str(case), fretdyn.Case.from_file(case)):
         s = fretdyn.stability(given)
         assert set(s) == set(STABILITY_COLUMNS) | {
-            "reference_zone", "connors_constant", "diameter", "mass_per_length"
+            "reference_zone", "condition", "plane", "connors_constant", "diameter",
+            "mass_per_length",
         }
         for key in STABILITY_COLUMNS:
             assert isinstance(s[key], np.ndarray) and s[key].shape == (len(modes),), key
@@ -345,10 +346,15 @@ def test_stability_equals_the_cli_bit_for_bit(tmp_path):
             assert same_bits(s[key], want), key
         assert s["mode"].dtype.kind == "i"
         assert s["reference_zone"] == [m["reference_zone"] for m in modes]
+        assert s["condition"] == [m["condition"] for m in modes]
+        assert s["plane"] == [m["plane"] or "" for m in modes]
         for key in ("connors_constant", "diameter", "mass_per_length"):
             assert s[key] == expected[key], key
-    # the example's 11 lowest modes are above their critical velocity (docs/FLOW.md)
-    assert int((s["ratio"] > 1.0).sum()) == 11
+    # the example's 11 lowest modes are above their critical velocity with the supports
+    # inactive (docs/FLOW.md); its support conditions follow
+    inactive = np.array([c == "support_inactive" for c in s["condition"]])
+    assert int((s["ratio"][inactive] > 1.0).sum()) == 11
+    assert len(set(s["condition"])) == 3
     assert np.array_equal(s["ratio"], s["effective_velocity"] / s["critical_velocity"])
     with pytest.raises(TypeError, match="fretdyn.stability takes a Case"):
         fretdyn.stability(42)

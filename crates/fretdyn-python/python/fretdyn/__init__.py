@@ -849,10 +849,14 @@ def stability(case: Union[Case, PathLike]) -> dict:
     Returns
     -------
     dict
-        One numpy array per column of ``stability.csv`` — ``mode``, ``frequency_hz`` (Hz),
-        ``damping_ratio``, ``reference_density`` (kg/m³), ``effective_velocity`` and
-        ``critical_velocity`` (m/s), ``ratio`` (U_eff/U_c; NaN where undefined, inf for an
-        undamped mode in a flow) — ``reference_zone`` (list of str), and the scalars
+        One row per mode: the basis's modes (condition ``support_inactive``), then those of
+        each support condition of ``[stability]`` (docs/FLOW.md). One numpy array per numeric
+        column of ``stability.csv`` — ``mode``, ``frequency_hz`` (Hz), ``damping_ratio``,
+        ``reference_density`` (kg/m³), ``effective_velocity`` and ``critical_velocity``
+        (m/s), ``ratio`` (U_eff/U_c; NaN where undefined, inf for an undamped mode in a
+        flow), ``out_of_plane_share`` (NaN when the structure has no plane) —
+        ``reference_zone``, ``condition`` and ``plane`` (``in_plane``, ``out_of_plane``,
+        ``mixed``, or ``""`` without a plane) as lists of str, and the scalars
         ``connors_constant``, ``diameter`` (m) and ``mass_per_length`` (kg/m).
 
     Raises

@@ -14,7 +14,8 @@
 //!   `[base_excitation]`;
 //! - `flow`: `[flow]` and its `[[flow.zones]]`;
 //! - `settings`: `[time]`, `[tangential]`, `[output]`, `[statistics]`;
-//! - `life`: `[life]`, the service life of `fretdyn life`.
+//! - `life`: `[life]`, the service life of `fretdyn life`;
+//! - `stability`: `[stability]`, the support conditions of the Connors check.
 //!
 //! What the sections share as they are built (a tube's model, the points' abscissae, how a
 //! point or a file is named) is in `shared`, below them. This module reads the file, holds
@@ -35,12 +36,14 @@ mod obstacle;
 mod quantities;
 mod settings;
 mod shared;
+mod stability;
 mod structure;
 mod structures;
 mod wear;
 
 pub use shared::TubeModel;
 pub(crate) use shared::named_file;
+pub use stability::{StabilityChecks, SupportCondition};
 
 use contacts::{ContactSection, build_contacts};
 use flow::FlowSection;
@@ -49,6 +52,7 @@ use loads::{BaseSection, LineLoadSection, LoadSection, ModalLoadSection, Turbule
 use settings::{
     OutputSection, SettingsSections, StatisticsSection, TangentialSection, TimeSection,
 };
+use stability::StabilitySection;
 use structure::{InitialSection, StructureSection};
 use structures::{StructureEntry, StructureParts};
 
@@ -58,7 +62,7 @@ use serde::Deserialize;
 
 use crate::error::{Error, Result};
 use crate::integrator::simulation::RunSettings;
-use crate::loads::flow::{Flow, StabilityReport};
+use crate::loads::flow::{Flow, SUPPORT_INACTIVE, StabilityReport};
 use crate::model::Model;
 
 /// A parsed, validated case.
@@ -89,6 +93,9 @@ pub struct Case {
     pub point_abscissae: Vec<Option<f64>>,
     /// The `[life]` section: the service life (THEORY §14.5), for `fretdyn life`.
     pub life: Option<crate::settings::life::LifeSettings>,
+    /// The `[stability]` section: the support conditions of the Connors check and the
+    /// structure's plane (docs/FLOW.md); `None` without one.
+    pub stability_checks: Option<Box<StabilityChecks>>,
 }
 
 impl Case {
@@ -127,11 +134,16 @@ impl Case {
         let echo = serde_json::to_value(&echo_value).unwrap_or(serde_json::Value::Null);
         let title = file.title.clone().unwrap_or_default();
         let life_section = file.life.take();
+        let stability_section = file.stability.take();
         let (model, settings, tube, flow, point_abscissae) = file.build(base, &mut warnings)?;
         // several structures: no one tube's wall (the criterion is then given in m, and
         // the perforation of a wall is not checked)
         let life = match life_section {
             Some(l) => Some(l.build(tube.as_deref())?),
+            None => None,
+        };
+        let stability_checks = match stability_section {
+            Some(s) => Some(Box::new(s.build(tube.as_deref(), &model)?)),
             None => None,
         };
         Ok(Self {
@@ -144,6 +156,7 @@ impl Case {
             warnings,
             point_abscissae,
             life,
+            stability_checks,
         })
     }
 
@@ -159,13 +172,67 @@ impl Case {
             flow: None,
             point_abscissae: Vec::new(),
             life: None,
+            stability_checks: None,
         }
     }
 
-    /// The Connors fluid-elastic stability check of every mode (docs/FLOW.md), for a case
-    /// with a `[flow]` section.
+    /// The Connors fluid-elastic stability check of every mode of the basis (the supports
+    /// inactive; docs/FLOW.md), for a case with a `[flow]` section: the check of a study's
+    /// `connors_max_ratio`. With the modes' planes when the structure has one.
     pub fn stability(&self) -> Option<StabilityReport> {
-        self.flow.as_ref().map(|f| f.connors(&self.model.basis))
+        let plane = self.plane_normal();
+        self.flow
+            .as_ref()
+            .map(|f| f.connors_in(&self.model.basis, SUPPORT_INACTIVE, plane))
+    }
+
+    /// [`Case::stability`] followed by the check of the modes of every support condition of
+    /// `[stability]` (THEORY §16; [`crate::structure::constrained`]), each condition's modes
+    /// numbered from 1: what `fretdyn stability` reports. `None` without `[flow]`; an error
+    /// when a condition's modes cannot be computed.
+    pub fn stability_checks(&self) -> Option<Result<StabilityReport>> {
+        let mut report = self.stability()?;
+        let (Some(checks), Some(flow)) = (&self.stability_checks, &self.flow) else {
+            return Some(Ok(report));
+        };
+        let plane = self.plane_normal();
+        for condition in &checks.conditions {
+            // a condition exists only on a tube (the section refuses it otherwise)
+            let Some(tube) = &self.tube else {
+                break;
+            };
+            let basis = match tube.structure.constrained_basis(
+                &tube.basis,
+                &condition.constraints,
+                condition.selection,
+            ) {
+                Ok(b) => b,
+                Err(e) => {
+                    return Some(Err(Error::invalid(
+                        "stability.conditions",
+                        format!("condition '{}': {e}", condition.name),
+                    )));
+                }
+            };
+            let resampled = flow.resampled((0.0, tube.structure.length()), |s0, s1| {
+                tube.structure.flow_stations(&basis, s0, s1)
+            });
+            report.modes.extend(
+                resampled
+                    .connors_in(&basis.basis, &condition.name, plane)
+                    .modes,
+            );
+        }
+        Some(Ok(report))
+    }
+
+    /// The unit normal of the structure's plane: `[stability] plane_normal`, or a planar
+    /// tube's.
+    pub fn plane_normal(&self) -> Option<nalgebra::Vector3<f64>> {
+        match &self.stability_checks {
+            Some(c) => c.plane_normal,
+            None => self.tube.as_ref().and_then(|t| t.structure.plane_normal()),
+        }
     }
 }
 
@@ -281,6 +348,7 @@ struct CaseFile {
     #[serde(default)]
     statistics: StatisticsSection,
     life: Option<LifeSection>,
+    stability: Option<StabilitySection>,
 }
 
 /// What a case file builds: the model, the settings, a tube's finite-element model, the flow,
@@ -375,6 +443,12 @@ impl CaseFile {
                     ),
                 ));
             }
+        }
+        if self.stability.is_some() {
+            return Err(Error::invalid(
+                "stability",
+                "the Connors check of a case of several structures is not supported yet: check each structure in a case of its own ([structure] with its [flow] and [stability])",
+            ));
         }
         let mut parts = Vec::with_capacity(self.structures.len());
         let mut point_abscissae = Vec::new();

@@ -288,6 +288,49 @@ pub struct ModeStability {
     pub critical_velocity: f64,
     /// `U_eff / U_c`; `None` when undefined (`U_eff = U_c = 0`).
     pub ratio: Option<f64>,
+    /// The support condition of the mode: `support_inactive` (the basis's modes), or the
+    /// name of a `[[stability.conditions]]` (docs/FLOW.md).
+    pub condition: String,
+    /// The mode's plane, when the structure has one (docs/FLOW.md).
+    pub plane: Option<Plane>,
+    /// The share of the mode's transverse displacement normal to the structure's plane,
+    /// `∫ (u⊥·n)² ds / ∫ |u⊥|² ds` over the tube, when it has a plane.
+    pub out_of_plane_share: Option<f64>,
+}
+
+/// The plane a mode moves in, from its [`ModeStability::out_of_plane_share`] `q`:
+/// out of plane when `q ≥ 0.9`, in plane when `q ≤ 0.1`, mixed between.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Plane {
+    /// In the structure's plane (`q ≤ 0.1`).
+    InPlane,
+    /// Normal to it (`q ≥ 0.9`).
+    OutOfPlane,
+    /// Neither.
+    Mixed,
+}
+
+impl Plane {
+    /// The class of a mode whose out-of-plane share is `q`.
+    pub fn of_share(q: f64) -> Self {
+        if q >= 0.9 {
+            Plane::OutOfPlane
+        } else if q <= 0.1 {
+            Plane::InPlane
+        } else {
+            Plane::Mixed
+        }
+    }
+
+    /// `in_plane`, `out_of_plane`, `mixed`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Plane::InPlane => "in_plane",
+            Plane::OutOfPlane => "out_of_plane",
+            Plane::Mixed => "mixed",
+        }
+    }
 }
 
 impl ModeStability {
@@ -311,7 +354,10 @@ pub struct StabilityReport {
 }
 
 /// Columns of [`StabilityReport::to_csv`].
-pub const STABILITY_CSV_HEADER: &str = "mode,frequency_hz,damping_ratio,reference_zone,reference_density,effective_velocity,critical_velocity,ratio";
+pub const STABILITY_CSV_HEADER: &str = "mode,frequency_hz,damping_ratio,reference_zone,reference_density,effective_velocity,critical_velocity,ratio,condition,plane,out_of_plane_share";
+
+/// The name of the condition of the basis's own modes (the supports inactive).
+pub const SUPPORT_INACTIVE: &str = "support_inactive";
 
 impl StabilityReport {
     /// The modes whose ratio exceeds 1.
@@ -332,7 +378,7 @@ impl StabilityReport {
         let mut text = format!("{STABILITY_CSV_HEADER}\n");
         for m in &self.modes {
             text.push_str(&format!(
-                "{},{},{},{},{},{},{},{}\n",
+                "{},{},{},{},{},{},{},{},{},{},{}\n",
                 m.mode,
                 m.frequency_hz,
                 m.damping_ratio,
@@ -340,7 +386,12 @@ impl StabilityReport {
                 m.reference_density,
                 m.effective_velocity,
                 m.critical_velocity,
-                m.ratio.map(|r| r.to_string()).unwrap_or_default()
+                m.ratio.map(|r| r.to_string()).unwrap_or_default(),
+                m.condition,
+                m.plane.map(Plane::name).unwrap_or_default(),
+                m.out_of_plane_share
+                    .map(|r| r.to_string())
+                    .unwrap_or_default()
             ));
         }
         text
@@ -349,8 +400,20 @@ impl StabilityReport {
 
 impl Flow {
     /// The Connors check of every mode of `basis` (the module documentation has the formulas).
-    /// Modes are those whose rows the stations hold (the basis's).
+    /// Modes are those whose rows the stations hold (the basis's); their condition is
+    /// [`SUPPORT_INACTIVE`], no plane.
     pub fn connors(&self, basis: &ModalBasis) -> StabilityReport {
+        self.connors_in(basis, SUPPORT_INACTIVE, None)
+    }
+
+    /// [`Flow::connors`] with the modes' condition named `condition` and, when the structure
+    /// has a plane of unit normal `plane_normal`, each mode's out-of-plane share and plane.
+    pub fn connors_in(
+        &self,
+        basis: &ModalBasis,
+        condition: &str,
+        plane_normal: Option<Vector3<f64>>,
+    ) -> StabilityReport {
         let modes = (0..basis.modes())
             .map(|i| {
                 // ∫ m/m_ref φ² over the whole tube: m is uniform, the ratio is 1
@@ -393,6 +456,7 @@ impl Flow {
                 } else {
                     Some(effective / critical)
                 };
+                let out_of_plane_share = plane_normal.map(|n| self.out_of_plane_share(i, &n));
                 ModeStability {
                     mode: i + 1,
                     frequency_hz: f,
@@ -402,6 +466,9 @@ impl Flow {
                     effective_velocity: effective,
                     critical_velocity: critical,
                     ratio,
+                    condition: condition.to_string(),
+                    plane: out_of_plane_share.map(Plane::of_share),
+                    out_of_plane_share,
                 }
             })
             .collect();
@@ -413,7 +480,42 @@ impl Flow {
         }
     }
 
-    /// The zone named `name`.
+    /// `∫ (u⊥·n)² ds / ∫ |u⊥|² ds` of mode `i` over the whole tube (`u⊥` the displacement
+    /// normal to the axis, `n` the unit normal of the structure's plane); 0 for a mode
+    /// without transverse displacement.
+    pub fn out_of_plane_share(&self, i: usize, n: &Vector3<f64>) -> f64 {
+        let (mut out, mut all) = (0.0, 0.0);
+        for st in &self.whole {
+            let u = st.translation(i);
+            let t = st.tangent;
+            let normal = u - t * u.dot(&t);
+            out += st.weight * normal.dot(n).powi(2);
+            all += st.weight * normal.norm_squared();
+        }
+        if all > 0.0 { out / all } else { 0.0 }
+    }
+
+    /// The same flow with the stations of its zones and of the whole tube (over `range`)
+    /// sampled again by `stations(s0, s1)`: on the modes of another basis of the same tube.
+    pub fn resampled(
+        &self,
+        range: (f64, f64),
+        stations: impl Fn(f64, f64) -> Vec<Station>,
+    ) -> Flow {
+        Flow {
+            zones: self
+                .zones
+                .iter()
+                .map(|z| FlowZone {
+                    stations: stations(z.span[0], z.span[1]),
+                    ..z.clone()
+                })
+                .collect(),
+            whole: stations(range.0, range.1),
+            ..self.clone()
+        }
+    }
+
     /// The fluid-elastic forces of the zones that have them, projected on the modes of
     /// frequencies `frequencies_hz` (THEORY §13): `None` when no zone has any.
     pub fn fluid_elastic(&self, frequencies_hz: &[f64]) -> Option<FluidElastic> {
@@ -487,6 +589,7 @@ impl Flow {
         total
     }
 
+    /// The zone named `name`.
     pub fn zone(&self, name: &str) -> Option<&FlowZone> {
         self.zones.iter().find(|z| z.name == name)
     }

@@ -8,10 +8,12 @@
 //! - [`tube`]: a tube line on supports, meshed with [`beam`] elements and reduced on its lowest
 //!   modes by [`eigen`];
 //! - [`eigen`]: the generalised symmetric eigenproblem `K φ = ω² M φ`;
+//! - [`constrained`]: the modes of a tube with chosen supports held (support-active modes);
 //! - [`line`]: stations and cells along a tube, where line loads and flow forces meet its modes.
 
 pub mod basis_file;
 pub mod beam;
+pub mod constrained;
 pub mod eigen;
 pub mod line;
 pub mod modal;

@@ -37,6 +37,55 @@ pub enum Damping {
     Rayleigh { alpha: f64, beta: f64 },
 }
 
+impl Damping {
+    /// The damping ratio of each mode of circular frequency `omega` (rad/s): the constant, the
+    /// first values of the per-mode list, or Rayleigh's `ξ = α/(2ω) + βω/2`.
+    pub fn ratios(&self, omega: &[f64]) -> Result<Vec<f64>> {
+        let p = omega.len();
+        Ok(match self {
+            Damping::Constant(x) => vec![*x; p],
+            Damping::PerMode(v) => {
+                if v.len() < p {
+                    return Err(Error::invalid(
+                        "structure.damping_ratio",
+                        format!(
+                            "has {} values for {p} modes kept: give one per mode",
+                            v.len()
+                        ),
+                    ));
+                }
+                v[..p].to_vec()
+            }
+            Damping::Rayleigh { alpha, beta } => {
+                let ratios: Vec<f64> = omega
+                    .iter()
+                    .map(|w| {
+                        if *w > 0.0 {
+                            0.5 * (alpha / w + beta * w)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                if let Some(i) = ratios.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
+                    return Err(Error::invalid(
+                        "structure.rayleigh",
+                        format!(
+                            "α = {}, β = {} give mode {} (ω = {} rad/s) the damping ratio ξ = α/(2ω) + βω/2 = {}: give α ≥ 0 in 1/s and β ≥ 0 in s that make it a finite number",
+                            number(*alpha),
+                            number(*beta),
+                            i + 1,
+                            number(omega[i]),
+                            number(ratios[i])
+                        ),
+                    ));
+                }
+                ratios
+            }
+        })
+    }
+}
+
 /// A tube finite-element model with its named points, mode selection and damping.
 #[derive(Debug, Clone)]
 pub struct TubeStructure {
@@ -86,49 +135,13 @@ impl TubeStructure {
                 ),
                 other => other,
             })?;
-        let p = modes.omega.len();
-        let damping_ratio = match &self.damping {
-            Damping::Constant(x) => vec![*x; p],
-            Damping::PerMode(v) => {
-                if v.len() < p {
-                    return Err(Error::invalid(
-                        "structure.damping_ratio",
-                        format!(
-                            "has {} values for {p} modes kept: give one per mode",
-                            v.len()
-                        ),
-                    ));
-                }
-                v[..p].to_vec()
-            }
-            Damping::Rayleigh { alpha, beta } => {
-                let ratios: Vec<f64> = modes
-                    .omega
-                    .iter()
-                    .map(|w| {
-                        if *w > 0.0 {
-                            0.5 * (alpha / w + beta * w)
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect();
-                if let Some(i) = ratios.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
-                    return Err(Error::invalid(
-                        "structure.rayleigh",
-                        format!(
-                            "α = {}, β = {} give mode {} (ω = {} rad/s) the damping ratio ξ = α/(2ω) + βω/2 = {}: give α ≥ 0 in 1/s and β ≥ 0 in s that make it a finite number",
-                            number(*alpha),
-                            number(*beta),
-                            i + 1,
-                            number(modes.omega[i]),
-                            number(ratios[i])
-                        ),
-                    ));
-                }
-                ratios
-            }
-        };
+        self.basis_of(assembled, modes)
+    }
+
+    /// The basis of `modes` (over the reduced DOFs of `assembled`): their damping from the
+    /// tube's damping model, the rows of its named points, the participation factors.
+    pub(crate) fn basis_of(&self, assembled: Assembled, modes: Modes) -> Result<TubeBasis> {
+        let damping_ratio = self.damping.ratios(&modes.omega)?;
         let points = self.named_points(&assembled, &modes.shapes);
         Ok(TubeBasis {
             basis: ModalBasis {
