@@ -483,6 +483,14 @@ fn flow_fluid_elastic_bad_input_names_the_field() {
             "flow.zones[0].fluid_elastic.mu",
         ),
         (
+            "{ model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu = 1.0, mu_drag = -0.5, flow_direction = [0.0, 0.0, 1.0] }",
+            "flow.zones[0].fluid_elastic.mu_drag",
+        ),
+        (
+            "{ model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu_drag = 0.5, flow_direction = [0.0, 0.0, 1.0] }",
+            "flow.zones[0].fluid_elastic.mu_lift",
+        ),
+        (
             "{ model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu = 1.0, flow_direction = [2.0, 0.0, 0.0] }",
             "flow.zones[0].fluid_elastic.flow_direction",
         ),

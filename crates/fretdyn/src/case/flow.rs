@@ -65,7 +65,10 @@ enum FluidElasticInput {
         #[serde(default)]
         drag_slope: f64,
         drag: f64,
-        mu: f64,
+        /// `μ` of both directions, unless `mu_lift` / `mu_drag` give theirs.
+        mu: Option<f64>,
+        mu_lift: Option<f64>,
+        mu_drag: Option<f64>,
         flow_direction: [f64; 3],
         #[serde(default = "default_delay_segments")]
         delay_segments: usize,
@@ -103,21 +106,42 @@ impl FluidElasticInput {
                 drag_slope,
                 drag,
                 mu,
+                mu_lift,
+                mu_drag,
                 flow_direction,
                 delay_segments,
             } => {
                 finite(*lift_slope, "lift_slope")?;
                 finite(*drag_slope, "drag_slope")?;
                 finite(*drag, "drag")?;
-                if !(mu.is_finite() && *mu >= 0.0) {
-                    return Err(Error::invalid(
-                        format!("{field}.mu"),
-                        format!(
-                            "must be a number ≥ 0, the time-lag factor of τ = μ D / U (got {})",
-                            number(*mu)
-                        ),
-                    ));
-                }
+                // each direction's μ: its own key, else `mu`
+                let lag = |own: Option<f64>, key: &str| -> Result<f64> {
+                    let (v, key) = match (own, mu) {
+                        (Some(v), _) => (v, key),
+                        (None, Some(v)) => (*v, "mu"),
+                        (None, None) => {
+                            return Err(Error::invalid(
+                                format!("{field}.{key}"),
+                                format!(
+                                    "is missing: give mu (the time-lag factor of τ = μ D / U for both directions) or both mu_lift and mu_drag"
+                                ),
+                            ));
+                        }
+                    };
+                    if v.is_finite() && v >= 0.0 {
+                        Ok(v)
+                    } else {
+                        Err(Error::invalid(
+                            format!("{field}.{key}"),
+                            format!(
+                                "must be a number ≥ 0, the time-lag factor of τ = μ D / U (got {})",
+                                number(v)
+                            ),
+                        ))
+                    }
+                };
+                let mu_lift = lag(*mu_lift, "mu_lift")?;
+                let mu_drag = lag(*mu_drag, "mu_drag")?;
                 if *delay_segments == 0 {
                     return Err(Error::invalid(
                         format!("{field}.delay_segments"),
@@ -149,7 +173,8 @@ impl FluidElasticInput {
                         lift_slope: *lift_slope,
                         drag_slope: *drag_slope,
                         drag: *drag,
-                        mu: *mu,
+                        mu_lift,
+                        mu_drag,
                     },
                     flow_direction: d,
                     delay_segments: *delay_segments,

@@ -200,7 +200,7 @@ pub fn midpoint_weights(s: &[f64], a: f64, b: f64) -> Vec<f64> {
 pub enum ZoneFluidElastic {
     /// The quasi-steady model with a time lag.
     QuasiSteady {
-        /// `C_L'`, `C_D'`, `C_D`, `μ`.
+        /// `C_L'`, `C_D'`, `C_D`, `μ_L`, `μ_D`.
         coefficients: QuasiSteady,
         /// Direction of the flow (drag); the lift is across it and the tube's axis.
         flow_direction: Vector3<f64>,
@@ -438,8 +438,11 @@ impl Flow {
                     coefficients,
                     flow_direction,
                     ..
-                } => (coefficients.mu, *flow_direction),
-                ZoneFluidElastic::Table(_) => (0.0, Vector3::zeros()),
+                } => (
+                    [coefficients.mu_lift, coefficients.mu_drag],
+                    *flow_direction,
+                ),
+                ZoneFluidElastic::Table(_) => ([0.0; 2], Vector3::zeros()),
             };
             let nodes: Vec<FlowNode> = zone
                 .stations
@@ -455,15 +458,19 @@ impl Flow {
                         zone.velocity.at(mid)
                     };
                     let (lift, drag) = cross_flow_axes(&st.tangent, &direction);
+                    let delay = |mu: f64| {
+                        if u_delay > 0.0 {
+                            mu * self.diameter / u_delay
+                        } else {
+                            0.0
+                        }
+                    };
                     FlowNode {
                         weight: st.weight,
                         density: zone.density,
                         velocity: u,
-                        delay: if u_delay > 0.0 {
-                            mu * self.diameter / u_delay
-                        } else {
-                            0.0
-                        },
+                        delay_lift: delay(mu[0]),
+                        delay_drag: delay(mu[1]),
                         diameter: self.diameter,
                         lift,
                         drag,
