@@ -546,3 +546,98 @@ fn flow_velocity_profile_matches_a_numerical_quadrature() {
         );
     }
 }
+
+/// Two-phase flow from a thermal-hydraulic map (docs/FLOW.md, "Two-phase flow"): quality `x`
+/// and mass flux `G` give the homogeneous density `ρ_h = 1/(x/ρ_g + (1 − x)/ρ_l)` (the mixture's
+/// specific volume, written here independently of the void fraction), and the zone's gap
+/// velocity carries the mass flux: `ρ_h U_∞ = G` with `U = U_∞ P/(P − D)` (upstream), `ρ_h U = G`
+/// (gap); `x = 0` is the liquid, `x = 1` the gas.
+#[test]
+fn flow_quality_and_mass_flux_give_the_homogeneous_density_and_velocity() {
+    use fretdyn::loads::flow::{homogeneous_density, homogeneous_void_fraction};
+    let (rl, rg, pd) = (740.0, 37.0, 1.44);
+    for (x, definition) in [
+        (0.0, "gap"),
+        (0.05, "upstream"),
+        (0.3, "gap"),
+        (1.0, "upstream"),
+    ] {
+        let g = 500.0;
+        let c = case(&pinned_tube(
+            0.05,
+            &format!(
+                "\n[flow]\npattern = \"rotated_square\"\npitch_ratio = {pd}\nvelocity_definition = \"{definition}\"\n\n[[flow.zones]]\nname = \"bend\"\nspan = [0.0, {L}]\nquality = {x}\nliquid_density = {rl}\ngas_density = {rg}\nmass_flux = {g}\n"
+            ),
+        ));
+        let zone = &c.flow.as_ref().unwrap().zones[0];
+        let rho_h = 1.0 / (x / rg + (1.0 - x) / rl);
+        assert!(
+            (zone.density / rho_h - 1.0).abs() < 1e-14,
+            "x {x}: ρ {} against {rho_h}",
+            zone.density
+        );
+        let u = zone.velocity.constant().unwrap();
+        let u_inf = if definition == "upstream" {
+            u * (pd - 1.0) / pd
+        } else {
+            u
+        };
+        assert!(
+            (zone.density * u_inf / g - 1.0).abs() < 1e-14,
+            "x {x}: ρU = {} against G = {g}",
+            zone.density * u_inf
+        );
+        // the effective velocity of a uniform zone is its velocity
+        let r = c.stability().unwrap();
+        assert!((r.modes[0].effective_velocity / u - 1.0).abs() < 1e-12);
+    }
+    // limits and the void fraction's definition
+    assert_eq!(homogeneous_void_fraction(0.0, rl, rg), 0.0);
+    assert_eq!(homogeneous_void_fraction(1.0, rl, rg), 1.0);
+    assert_eq!(homogeneous_density(0.0, rl, rg), rl);
+    assert_eq!(homogeneous_density(1.0, rl, rg), rg);
+    // ε is the gas's volume fraction: x/ρ_g over the mixture's specific volume
+    let x = 0.2;
+    let eps = homogeneous_void_fraction(x, rl, rg);
+    let volume = x / rg + (1.0 - x) / rl;
+    assert!((eps - (x / rg) / volume).abs() < 1e-15);
+}
+
+/// A mass-flux profile is a velocity profile `G(s)/ρ`; bad two-phase input names its field.
+#[test]
+fn flow_mass_flux_profile_and_bad_two_phase_input() {
+    let zone = |keys: &str| {
+        pinned_tube(
+            0.05,
+            &format!("{FLOW_HEAD}\n[[flow.zones]]\nname = \"z\"\nspan = [0.0, {L}]\n{keys}\n"),
+        )
+    };
+    let c = case(&zone(
+        "quality = 0.1\nliquid_density = 740.0\ngas_density = 37.0\nmass_flux_profile = [[0.0, 300.0], [1.0, 600.0]]",
+    ));
+    let z = &c.flow.as_ref().unwrap().zones[0];
+    for s in [0.0, 0.25, 0.5, 1.0] {
+        let g = 300.0 + 300.0 * s;
+        assert!((z.density * z.velocity.at(s) / g - 1.0).abs() < 1e-14);
+    }
+    for (keys, field) in [
+        (
+            "quality = 1.5\nliquid_density = 740.0\ngas_density = 37.0\nmass_flux = 500.0",
+            "flow.zones[0].quality",
+        ),
+        (
+            "quality = 0.1\nvoid_fraction = 0.5\nliquid_density = 740.0\ngas_density = 37.0\nmass_flux = 500.0",
+            "flow.zones[0].quality",
+        ),
+        (
+            "density = 740.0\nmass_flux = -5.0",
+            "flow.zones[0].mass_flux",
+        ),
+        (
+            "density = 740.0\nmass_flux = 5.0\nvelocity = 1.0",
+            "flow.zones[0]",
+        ),
+    ] {
+        assert_eq!(error_field(&zone(keys)), field, "{keys}");
+    }
+}

@@ -10,7 +10,7 @@ use crate::error::{Error, Result, number};
 use crate::loads::flow::ZoneFluidElastic;
 use crate::loads::flow::{
     Bundle, BundlePattern, Flow, FlowZone, Station, VelocityDefinition, VelocityProfile,
-    midpoint_weights,
+    homogeneous_density, homogeneous_void_fraction, midpoint_weights,
 };
 use crate::loads::fluid_elastic::{QuasiSteady, ReducedVelocityTable};
 use crate::model::Model;
@@ -47,11 +47,17 @@ struct ZoneSection {
     to: Option<String>,
     density: Option<f64>,
     void_fraction: Option<f64>,
+    /// Steam quality `x` (mass fraction of gas): the homogeneous void fraction.
+    quality: Option<f64>,
     liquid_density: Option<f64>,
     gas_density: Option<f64>,
     velocity: Option<f64>,
     /// `[[s, U], ...]`.
     velocity_profile: Option<Vec<[f64; 2]>>,
+    /// `G`, kg/(m² s): the velocity is `G / ρ`.
+    mass_flux: Option<f64>,
+    /// `[[s, G], ...]`.
+    mass_flux_profile: Option<Vec<[f64; 2]>>,
     /// The zone's fluid-elastic forces (THEORY §13).
     fluid_elastic: Option<FluidElasticInput>,
 }
@@ -502,24 +508,31 @@ impl ZoneSection {
         }
         let (s0, s1) = (s0.max(lo), s1.min(hi));
         let density = self.density(field)?;
-        let velocity = match (self.velocity, &self.velocity_profile) {
-            (Some(u), None) => VelocityProfile::Constant(u),
-            (None, Some(rows)) => VelocityProfile::Table {
-                s: rows.iter().map(|r| r[0]).collect(),
-                velocity: rows.iter().map(|r| r[1]).collect(),
-            },
+        let profile = |rows: &Vec<[f64; 2]>, scale: f64| VelocityProfile::Table {
+            s: rows.iter().map(|r| r[0]).collect(),
+            velocity: rows.iter().map(|r| r[1] * scale).collect(),
+        };
+        let given = (
+            self.velocity,
+            &self.velocity_profile,
+            self.mass_flux,
+            &self.mass_flux_profile,
+        );
+        let (velocity, key) = match given {
+            (Some(u), None, None, None) => (VelocityProfile::Constant(u), "velocity"),
+            (None, Some(rows), None, None) => (profile(rows, 1.0), "velocity_profile"),
+            // U = G / ρ: the mass flux is referred to the same section as the velocity
+            // (velocity_definition), the density is the zone's (homogeneous) one
+            (None, None, Some(g), None) => (VelocityProfile::Constant(g / density), "mass_flux"),
+            (None, None, None, Some(rows)) => (profile(rows, 1.0 / density), "mass_flux_profile"),
             _ => {
                 return Err(Error::invalid(
                     field,
-                    "give either velocity = U (m/s) or velocity_profile = [[s, U], ...] (m, m/s; linear in s)",
+                    "give one of velocity = U (m/s), velocity_profile = [[s, U], ...] (m, m/s; linear in s), mass_flux = G (kg/(m² s); U = G/ρ) or mass_flux_profile = [[s, G], ...]",
                 ));
             }
         };
-        let vfield = if self.velocity.is_some() {
-            format!("{field}.velocity")
-        } else {
-            format!("{field}.velocity_profile")
-        };
+        let vfield = format!("{field}.{key}");
         // as given, then as gap velocities (an upstream velocity times P/(P − D) may overflow)
         velocity.validate(&vfield)?;
         let velocity = velocity.scaled(factor);
@@ -565,27 +578,38 @@ impl ZoneSection {
                 ))
             }
         };
-        match (
-            self.density,
-            self.void_fraction,
-            self.liquid_density,
-            self.gas_density,
-        ) {
+        let alpha = match (self.void_fraction, self.quality) {
+            (Some(a), None) => Some((a, "void_fraction")),
+            (None, Some(x)) => Some((x, "quality")),
+            (None, None) => None,
+            (Some(_), Some(_)) => {
+                return Err(Error::invalid(
+                    format!("{field}.quality"),
+                    "give either void_fraction or quality (the homogeneous void fraction follows from it), not both",
+                ));
+            }
+        };
+        match (self.density, alpha, self.liquid_density, self.gas_density) {
             (Some(rho), None, None, None) => check(rho, "density", "a fluid density > 0 in kg/m³"),
-            (None, Some(alpha), Some(rl), Some(rg)) => {
-                if !(alpha.is_finite() && (0.0..=1.0).contains(&alpha)) {
+            (None, Some((a, key)), Some(rl), Some(rg)) => {
+                if !(a.is_finite() && (0.0..=1.0).contains(&a)) {
                     return Err(Error::invalid(
-                        format!("{field}.void_fraction"),
-                        format!("must be in [0, 1] (got {})", number(alpha)),
+                        format!("{field}.{key}"),
+                        format!("must be in [0, 1] (got {})", number(a)),
                     ));
                 }
                 let rl = check(rl, "liquid_density", "a density > 0 in kg/m³")?;
                 let rg = check(rg, "gas_density", "a density > 0 in kg/m³")?;
-                Ok((1.0 - alpha) * rl + alpha * rg)
+                let alpha = if key == "quality" {
+                    homogeneous_void_fraction(a, rl, rg)
+                } else {
+                    a
+                };
+                Ok(homogeneous_density(alpha, rl, rg))
             }
             _ => Err(Error::invalid(
                 field,
-                "give either density = ρ (kg/m³) or void_fraction, liquid_density and gas_density (homogeneous two-phase density (1 − α) ρ_l + α ρ_g)",
+                "give either density = ρ (kg/m³) or void_fraction (or quality), liquid_density and gas_density (homogeneous two-phase density (1 − α) ρ_l + α ρ_g)",
             )),
         }
     }

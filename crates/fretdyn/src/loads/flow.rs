@@ -177,6 +177,18 @@ impl VelocityProfile {
     }
 }
 
+/// Homogeneous void fraction of a two-phase flow of steam quality `x` (mass fraction of gas),
+/// liquid and gas densities `ρ_l`, `ρ_g` (no slip between the phases):
+/// `ε = x ρ_l / (x ρ_l + (1 − x) ρ_g)` (docs/FLOW.md, "Two-phase flow").
+pub fn homogeneous_void_fraction(quality: f64, liquid: f64, gas: f64) -> f64 {
+    quality * liquid / (quality * liquid + (1.0 - quality) * gas)
+}
+
+/// Homogeneous density `ρ_h = ε ρ_g + (1 − ε) ρ_l` of void fraction `ε`, kg/m³.
+pub fn homogeneous_density(void_fraction: f64, liquid: f64, gas: f64) -> f64 {
+    (1.0 - void_fraction) * liquid + void_fraction * gas
+}
+
 /// Quadrature weights of stations at the sorted abscissae `s` covering `[a, b]` (a midpoint
 /// rule: each station carries from the midpoint with its neighbour before to the one after,
 /// the first from `a`, the last to `b`).
