@@ -641,3 +641,149 @@ fn flow_mass_flux_profile_and_bad_two_phase_input() {
         assert_eq!(error_field(&zone(keys)), field, "{keys}");
     }
 }
+
+/// Viscous damping (docs/FLOW.md, "Damping models") recomputed independently: the power
+/// dissipated in the oscillating Stokes layers on the tube (radius `a`) and on a concentric
+/// wall (radius `b`), `μ V²/(2δ)` per unit area for a slip of amplitude `V`, with the slip of
+/// the potential flow in the annulus — the potential `φ = U (A r + B/r) cos θ` solved here from
+/// its two wall conditions, the slip from `∂φ/∂θ` by central differences — integrated over `θ`
+/// by the trapezoidal rule (exact for these trigonometric integrands); `c = 2P/U²`,
+/// `ζ = c/(2mω)`.
+#[test]
+fn flow_viscous_damping_is_the_stokes_layers_dissipation() {
+    use fretdyn::loads::flow_damping::{ViscousDamping, viscous_damping_ratio};
+    let (rho, nu, m, d) = (740.0, 1.2e-7, 0.6, 0.02);
+    let a = 0.5 * d;
+    for (f, ratio) in [
+        (10.0, f64::INFINITY),
+        (10.0, 1.6),
+        (45.0, 1.3),
+        (200.0, 3.0),
+    ] {
+        let w = 2.0 * PI * f;
+        let delta = (2.0 * nu / w).sqrt();
+        let mu = rho * nu;
+        let u = 1.0;
+        let b = a * ratio;
+        // ∂φ/∂r = U cos θ at r = a, 0 at r = b: A − B/a² = 1, A − B/b² = 0
+        let (aa, bb) = if b.is_finite() {
+            let bb = 1.0 / (1.0 / (b * b) - 1.0 / (a * a));
+            (bb / (b * b), bb)
+        } else {
+            (0.0, -a * a)
+        };
+        let phi = |r: f64, th: f64| u * (aa * r + bb / r) * th.cos();
+        let n = 64;
+        let h = 1e-6;
+        let mut power = 0.0;
+        for k in 0..n {
+            let th = 2.0 * PI * k as f64 / n as f64;
+            let tangential = |r: f64| (phi(r, th + h) - phi(r, th - h)) / (2.0 * h * r);
+            // the tube's own tangential velocity is −U sin θ, the outer wall is still
+            let inner = tangential(a) + u * th.sin();
+            power += mu * inner * inner / (2.0 * delta) * a * 2.0 * PI / n as f64;
+            if b.is_finite() {
+                let outer = tangential(b);
+                power += mu * outer * outer / (2.0 * delta) * b * 2.0 * PI / n as f64;
+            }
+        }
+        let c = 2.0 * power / (u * u);
+        let expected = c / (2.0 * m * w);
+        let v = ViscousDamping {
+            density: rho,
+            kinematic_viscosity: nu,
+            confinement: ratio,
+        };
+        let zeta = viscous_damping_ratio(f, &v, d, m);
+        assert!(
+            (zeta / expected - 1.0).abs() < 1e-8,
+            "f {f}, D_e/D {ratio}: ζ_v {zeta} against {expected}"
+        );
+    }
+}
+
+/// `[flow.damping]`: the check's damping is the basis's plus the models' (each reported), the
+/// critical velocity scales as `√δ` of the total, squeeze film as `1/f`; `in_run` adds the
+/// fluid's terms to the run's damping without counting them twice in the check.
+#[test]
+fn flow_damping_models_add_to_the_connors_check() {
+    let zone =
+        "\n[[flow.zones]]\nname = \"all\"\nspan = [0.0, 1.0]\ndensity = 740.0\nvelocity = 1.0\n";
+    let models = "\n[flow.damping]\nviscous = { density = 740.0, kinematic_viscosity = 1.2e-7, confinement = 1.5 }\ntwo_phase = 0.01\nfriction = 0.004\nsqueeze_film = { ratio = 0.02, frequency = 30.0 }\n";
+    let plain = case(&pinned_tube(0.05, &format!("{FLOW_HEAD}{zone}")))
+        .stability()
+        .unwrap();
+    let with = case(&pinned_tube(0.05, &format!("{FLOW_HEAD}{models}{zone}")));
+    let r = with.stability().unwrap();
+    for (a, b) in plain.modes.iter().zip(&r.modes) {
+        let t = b.damping_terms.expect("the terms of each mode");
+        assert_eq!(t.basis, 0.02);
+        assert_eq!(t.two_phase, Some(0.01));
+        assert_eq!(t.friction, Some(0.004));
+        let sf = t.squeeze_film.unwrap();
+        assert!((sf * b.frequency_hz / (0.02 * 30.0) - 1.0).abs() < 1e-14);
+        let total = 0.02 + t.viscous.unwrap() + 0.01 + 0.004 + sf;
+        assert!((b.damping_ratio / total - 1.0).abs() < 1e-15);
+        // U_c ∝ √δ: the same mode, frequency, density and mass
+        let scale = (b.damping_ratio / a.damping_ratio).sqrt();
+        assert!(
+            (b.critical_velocity / (a.critical_velocity * scale) - 1.0).abs() < 1e-13,
+            "mode {}: {} against {}",
+            b.mode,
+            b.critical_velocity,
+            a.critical_velocity * scale
+        );
+        assert!(a.damping_terms.is_none());
+    }
+    let json = serde_json::to_string(&r).unwrap();
+    assert!(json.contains("\"damping_terms\":{\"basis\":0.02,\"viscous\":"));
+    assert!(
+        !serde_json::to_string(&plain)
+            .unwrap()
+            .contains("damping_terms")
+    );
+    // in_run: the run's damping gains the viscous and two-phase terms; the check is unchanged
+    let run = case(&pinned_tube(
+        0.05,
+        &format!("{FLOW_HEAD}{models}in_run = true\n{zone}"),
+    ));
+    let checked = run.stability().unwrap();
+    for (i, (m, n)) in checked.modes.iter().zip(&r.modes).enumerate() {
+        assert_eq!(m.damping_ratio, n.damping_ratio);
+        let t = m.damping_terms.unwrap();
+        assert_eq!(t.basis, 0.02);
+        assert_eq!(
+            run.model.basis.damping_ratio[i],
+            0.02 + (t.viscous.unwrap() + 0.01)
+        );
+        assert_eq!(with.model.basis.damping_ratio[i], 0.02);
+    }
+}
+
+#[test]
+fn flow_damping_bad_input_names_the_field() {
+    let zone =
+        "\n[[flow.zones]]\nname = \"all\"\nspan = [0.0, 1.0]\ndensity = 740.0\nvelocity = 1.0\n";
+    for (models, field) in [
+        ("two_phase = -0.01", "flow.damping.two_phase"),
+        ("friction = nan", "flow.damping.friction"),
+        (
+            "viscous = { density = 740.0, kinematic_viscosity = 1.2e-7, confinement = 0.9 }",
+            "flow.damping.viscous.confinement",
+        ),
+        (
+            "viscous = { density = 740.0, kinematic_viscosity = 0.0 }",
+            "flow.damping.viscous.kinematic_viscosity",
+        ),
+        (
+            "squeeze_film = { ratio = 0.01, frequency = 0.0 }",
+            "flow.damping.squeeze_film.frequency",
+        ),
+    ] {
+        let text = pinned_tube(
+            0.05,
+            &format!("{FLOW_HEAD}\n[flow.damping]\n{models}\n{zone}"),
+        );
+        assert_eq!(error_field(&text), field, "{models}");
+    }
+}

@@ -5,6 +5,7 @@
 use nalgebra::Vector3;
 use serde::Deserialize;
 
+use super::flow_damping::DampingSection;
 use super::shared::{Abscissae, TubeModel, point_index};
 use crate::error::{Error, Result, number};
 use crate::loads::flow::ZoneFluidElastic;
@@ -31,6 +32,8 @@ pub(super) struct FlowSection {
     /// Default: the tube's mass per unit length (tube, inner fluid, added mass).
     mass_per_length: Option<f64>,
     zones: Vec<ZoneSection>,
+    /// The damping models of the check.
+    damping: Option<DampingSection>,
 }
 
 fn default_connors_constant() -> f64 {
@@ -351,6 +354,7 @@ impl FlowSection {
             connors_constant: self.connors_constant,
             zones: zones.into_iter().map(|(_, z)| z).collect(),
             whole,
+            damping: self.damping.as_ref().map(|d| d.build()).transpose()?,
         })
     }
 }

@@ -24,6 +24,7 @@
 
 use nalgebra::Vector3;
 
+use crate::loads::flow_damping::{DampingModels, DampingTerms};
 use crate::loads::fluid_elastic::{FlowNode, FluidElastic, QuasiSteady, ReducedVelocityTable};
 use serde::{Deserialize, Serialize};
 
@@ -271,6 +272,8 @@ pub struct Flow {
     pub zones: Vec<FlowZone>,
     /// Stations over the whole tube (the denominator `∫ φ² ds` of `U_eff²`).
     pub whole: Vec<Station>,
+    /// The damping models added to the basis's damping in the check (`[flow.damping]`).
+    pub damping: Option<DampingModels>,
 }
 
 /// `U_c = K f D √(m δ / (ρ D²))`, `δ = 2π ζ` (Connors; Pettigrew & Taylor 2003): the critical
@@ -300,6 +303,9 @@ pub struct ModeStability {
     pub critical_velocity: f64,
     /// `U_eff / U_c`; `None` when undefined (`U_eff = U_c = 0`).
     pub ratio: Option<f64>,
+    /// The terms of `damping_ratio` (their sum), with `[flow.damping]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping_terms: Option<DampingTerms>,
 }
 
 impl ModeStability {
@@ -391,7 +397,12 @@ impl Flow {
                     0.0
                 };
                 let f = basis.omega[i] / std::f64::consts::TAU;
-                let zeta = basis.damping_ratio[i];
+                // the basis's damping, plus the models' ([flow.damping])
+                let damping_terms = self.damping.as_ref().map(|d| {
+                    let zeta = basis.damping_ratio[i];
+                    d.terms(i, zeta, f, self.diameter, self.mass_per_length)
+                });
+                let zeta = damping_terms.map_or(basis.damping_ratio[i], |t| t.total());
                 let critical = connors_critical_velocity(
                     f,
                     zeta,
@@ -414,6 +425,7 @@ impl Flow {
                     effective_velocity: effective,
                     critical_velocity: critical,
                     ratio,
+                    damping_terms,
                 }
             })
             .collect();
