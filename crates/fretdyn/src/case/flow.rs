@@ -131,9 +131,7 @@ impl FluidElasticInput {
                         (None, None) => {
                             return Err(Error::invalid(
                                 format!("{field}.{key}"),
-                                format!(
-                                    "is missing: give mu (the time-lag factor of τ = μ D / U for both directions) or both mu_lift and mu_drag"
-                                ),
+                                "is missing: give mu (the time-lag factor of τ = μ D / U for both directions) or both mu_lift and mu_drag",
                             ));
                         }
                     };
