@@ -12,9 +12,9 @@
 //!   kinematic viscosity `ν`, in the thin Stokes-layer limit (`δ = √(2ν/ω) ≪ D`), confined in
 //!   a concentric cylinder of diameter `D_e`. Derived in docs/FLOW.md from the dissipation of
 //!   the oscillating boundary layers on both walls under the potential-flow slip of the
-//!   annulus (`c = 2π ρ (D/2) ω δ` per unit length unconfined, `ζ = c / (2 m ω)`); the same
-//!   form as the design guides' viscous term (Rogers, Taylor & Pettigrew 1984, as cited by
-//!   Pettigrew & Taylor 2003; not read here). `m` is the tube's mass per unit length.
+//!   annulus (`c = 2π ρ (D/2) ω δ` per unit length unconfined, `ζ = c / (2 m ω)`); the form
+//!   the design guides' viscous term is recalled to have (Rogers et al. 1984, not read
+//!   here). `m` is the tube's mass per unit length.
 //! - `ζ_TP` (two-phase), `ζ_F` (friction at the supports): ratios the user takes from a design
 //!   guide; no formula was readable (docs/FLOW.md says what was searched).
 //! - `ζ_SF`: squeeze-film damping at the supports, inversely proportional to the frequency (as
