@@ -787,3 +787,82 @@ fn flow_damping_bad_input_names_the_field() {
         assert_eq!(error_field(&text), field, "{models}");
     }
 }
+
+/// A U-bend's coefficients by plane (`in_plane`, `out_of_plane`) are the lift's and drag's
+/// the flow's direction makes them: flow normal to the bend's plane (examples/ubend_flow.toml,
+/// the bend in xz, flow along y): the lift is in-plane; flow in the plane (along z, over the
+/// apex): the drag is in-plane. The modal matrices equal, bit for bit, those of the explicit
+/// keys. A straight zone, or a flow oblique to the plane, is refused.
+#[test]
+fn flow_u_bend_coefficients_by_plane_resolve_into_lift_and_drag() {
+    let text = std::fs::read_to_string("../../examples/ubend_flow.toml").unwrap();
+    let old = "fluid_elastic = { model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu = 1.0, flow_direction = [0.0, 1.0, 0.0], delay_segments = 4 }";
+    assert!(text.contains(old));
+    let with = |fe: &str, span: &str| {
+        let t = text.replace(old, fe);
+        let t = if span.is_empty() {
+            t
+        } else {
+            t.replace(
+                "from = \"cold_leg_plate\"\nto = \"hot_leg_plate\"",
+                &format!("span = {span}"),
+            )
+        };
+        Case::from_toml_str(&t, Path::new("../../examples"))
+    };
+    let fe = |keys: &str, dir: &str| {
+        format!(
+            "fluid_elastic = {{ model = \"quasi_steady\", {keys}, drag = 1.0, flow_direction = {dir} }}"
+        )
+    };
+    let planes = "in_plane = { slope = -3.0, mu = 1.0 }, out_of_plane = { slope = -1.0, mu = 0.5 }";
+    for (dir, span, explicit) in [
+        (
+            "[0.0, 1.0, 0.0]",
+            "",
+            "lift_slope = -3.0, mu_lift = 1.0, drag_slope = -1.0, mu_drag = 0.5",
+        ),
+        (
+            "[0.0, 0.0, 1.0]",
+            "[2.6, 2.97]",
+            "lift_slope = -1.0, mu_lift = 0.5, drag_slope = -3.0, mu_drag = 1.0",
+        ),
+    ] {
+        let a = with(&fe(planes, dir), span).unwrap_or_else(|e| panic!("{e}"));
+        let b = with(&fe(explicit, dir), span).unwrap_or_else(|e| panic!("{e}"));
+        let (fa, fb) = (
+            a.model.fluid_elastic.unwrap(),
+            b.model.fluid_elastic.unwrap(),
+        );
+        assert_eq!(fa, fb, "flow {dir}");
+        // and not the other assignment
+        let swapped = if explicit.starts_with("lift_slope = -3.0") {
+            "lift_slope = -1.0, mu_lift = 0.5, drag_slope = -3.0, mu_drag = 1.0"
+        } else {
+            "lift_slope = -3.0, mu_lift = 1.0, drag_slope = -1.0, mu_drag = 0.5"
+        };
+        let c = with(&fe(swapped, dir), span).unwrap();
+        assert_ne!(fa, c.model.fluid_elastic.unwrap(), "flow {dir}");
+    }
+    for (dir, span, field) in [
+        (
+            "[0.0, 1.0, 1.0]",
+            "",
+            "flow.zones[1].fluid_elastic.flow_direction",
+        ),
+        (
+            "[0.0, 1.0, 0.0]",
+            "[0.2, 1.8]",
+            "flow.zones[1].fluid_elastic.in_plane",
+        ),
+    ] {
+        let e = with(&fe(planes, dir), span).expect_err("refused");
+        assert_eq!(e.field(), Some(field), "{e}");
+    }
+    let e = with(
+        &fe(&format!("{planes}, lift_slope = -3.0"), "[0.0, 1.0, 0.0]"),
+        "",
+    )
+    .expect_err("both ways refused");
+    assert_eq!(e.field(), Some("flow.zones[1].fluid_elastic.in_plane"));
+}

@@ -70,9 +70,11 @@ struct ZoneSection {
 #[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
 enum FluidElasticInput {
     QuasiSteady {
-        lift_slope: f64,
-        #[serde(default)]
-        drag_slope: f64,
+        lift_slope: Option<f64>,
+        drag_slope: Option<f64>,
+        /// A U-bend's coefficients by plane instead of by direction.
+        in_plane: Option<PlaneInput>,
+        out_of_plane: Option<PlaneInput>,
         drag: f64,
         /// `μ` of both directions, unless `mu_lift` / `mu_drag` give theirs.
         mu: Option<f64>,
@@ -87,6 +89,16 @@ enum FluidElasticInput {
         damping: Vec<f64>,
         stiffness: Vec<f64>,
     },
+}
+
+/// `in_plane = { slope, mu }` / `out_of_plane = { slope, mu }`: a planar zone's quasi-steady
+/// stiffness coefficient and delay factor by plane, resolved into lift and drag by the flow's
+/// direction against the zone's plane.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlaneInput {
+    slope: f64,
+    mu: Option<f64>,
 }
 
 fn default_delay_segments() -> usize {
@@ -113,6 +125,8 @@ impl FluidElasticInput {
             FluidElasticInput::QuasiSteady {
                 lift_slope,
                 drag_slope,
+                in_plane,
+                out_of_plane,
                 drag,
                 mu,
                 mu_lift,
@@ -120,8 +134,56 @@ impl FluidElasticInput {
                 flow_direction,
                 delay_segments,
             } => {
-                finite(*lift_slope, "lift_slope")?;
-                finite(*drag_slope, "drag_slope")?;
+                let d = Vector3::from(*flow_direction);
+                if !(d.iter().all(|v| v.is_finite()) && d.norm() > 0.0) {
+                    return Err(Error::invalid(
+                        format!("{field}.flow_direction"),
+                        "must be a nonzero finite vector [x, y, z], the direction of the cross flow",
+                    ));
+                }
+                let d = d.normalize();
+                // by plane: resolved into lift and drag (the absent plane: no stiffness, the
+                // other's delay)
+                let by_plane = in_plane.is_some() || out_of_plane.is_some();
+                let (lift_slope, drag_slope, mu_lift, mu_drag) = if by_plane {
+                    if lift_slope.is_some()
+                        || drag_slope.is_some()
+                        || mu_lift.is_some()
+                        || mu_drag.is_some()
+                    {
+                        return Err(Error::invalid(
+                            format!("{field}.in_plane"),
+                            "give the coefficients either by plane (in_plane, out_of_plane) or by direction (lift_slope, drag_slope, mu_lift, mu_drag), not both",
+                        ));
+                    }
+                    let flow_in_plane = flow_in_zone_plane(field, stations, &d)?;
+                    let pick = |p: &Option<PlaneInput>, other: &Option<PlaneInput>| {
+                        let mu_other = other.as_ref().and_then(|o| o.mu).or(*mu);
+                        match p {
+                            Some(p) => (Some(p.slope), p.mu.or(*mu)),
+                            None => (Some(0.0), mu_other),
+                        }
+                    };
+                    let (inp, out) = (pick(in_plane, out_of_plane), pick(out_of_plane, in_plane));
+                    // flow in the plane: the drag is in-plane, the lift out of plane
+                    let (lift, drag) = if flow_in_plane {
+                        (out, inp)
+                    } else {
+                        (inp, out)
+                    };
+                    (lift.0, drag.0, lift.1, drag.1)
+                } else {
+                    (*lift_slope, *drag_slope, *mu_lift, *mu_drag)
+                };
+                let Some(lift_slope) = lift_slope else {
+                    return Err(Error::invalid(
+                        format!("{field}.lift_slope"),
+                        "is missing: give lift_slope (and drag_slope), or in_plane/out_of_plane for a planar zone",
+                    ));
+                };
+                let drag_slope = drag_slope.unwrap_or(0.0);
+                finite(lift_slope, "lift_slope")?;
+                finite(drag_slope, "drag_slope")?;
                 finite(*drag, "drag")?;
                 // each direction's μ: its own key, else `mu`
                 let lag = |own: Option<f64>, key: &str| -> Result<f64> {
@@ -147,22 +209,14 @@ impl FluidElasticInput {
                         ))
                     }
                 };
-                let mu_lift = lag(*mu_lift, "mu_lift")?;
-                let mu_drag = lag(*mu_drag, "mu_drag")?;
+                let mu_lift = lag(mu_lift, "mu_lift")?;
+                let mu_drag = lag(mu_drag, "mu_drag")?;
                 if *delay_segments == 0 {
                     return Err(Error::invalid(
                         format!("{field}.delay_segments"),
                         "must be at least 1",
                     ));
                 }
-                let d = Vector3::from(*flow_direction);
-                if !(d.iter().all(|v| v.is_finite()) && d.norm() > 0.0) {
-                    return Err(Error::invalid(
-                        format!("{field}.flow_direction"),
-                        "must be a nonzero finite vector [x, y, z], the direction of the cross flow",
-                    ));
-                }
-                let d = d.normalize();
                 if let Some(st) = stations
                     .iter()
                     .find(|st| (d - st.tangent * d.dot(&st.tangent)).norm() < 1e-6)
@@ -177,8 +231,8 @@ impl FluidElasticInput {
                 }
                 Ok(ZoneFluidElastic::QuasiSteady {
                     coefficients: QuasiSteady {
-                        lift_slope: *lift_slope,
-                        drag_slope: *drag_slope,
+                        lift_slope,
+                        drag_slope,
                         drag: *drag,
                         mu_lift,
                         mu_drag,
@@ -225,6 +279,39 @@ impl FluidElasticInput {
                 }))
             }
         }
+    }
+}
+
+/// Whether the flow `d` lies in the plane of the zone's axis (`true`) or is normal to it
+/// (`false`); an error on `{field}.in_plane` when the zone is straight or not planar, on
+/// `{field}.flow_direction` when the flow is neither.
+fn flow_in_zone_plane(field: &str, stations: &[Station], d: &Vector3<f64>) -> Result<bool> {
+    let t0 = stations.first().map_or(Vector3::zeros(), |s| s.tangent);
+    let normal = stations
+        .iter()
+        .map(|s| t0.cross(&s.tangent))
+        .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+        .unwrap_or(Vector3::zeros());
+    let planar = normal.norm() > 1e-6 && {
+        let n = normal.normalize();
+        stations.iter().all(|s| s.tangent.dot(&n).abs() < 1e-6)
+    };
+    if !planar {
+        return Err(Error::invalid(
+            format!("{field}.in_plane"),
+            "the zone's axis is straight or not planar, so it has no plane: give lift_slope and drag_slope (across and along the flow)",
+        ));
+    }
+    let n = normal.normalize();
+    if d.dot(&n).abs() < 1e-6 {
+        Ok(true)
+    } else if d.cross(&n).norm() < 1e-6 {
+        Ok(false)
+    } else {
+        Err(Error::invalid(
+            format!("{field}.flow_direction"),
+            "lies neither in the zone's plane nor normal to it: in_plane/out_of_plane cannot name the lift and drag; give lift_slope and drag_slope",
+        ))
     }
 }
 
