@@ -483,6 +483,14 @@ fn flow_fluid_elastic_bad_input_names_the_field() {
             "flow.zones[0].fluid_elastic.mu",
         ),
         (
+            "{ model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu = 1.0, mu_drag = -0.5, flow_direction = [0.0, 0.0, 1.0] }",
+            "flow.zones[0].fluid_elastic.mu_drag",
+        ),
+        (
+            "{ model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu_drag = 0.5, flow_direction = [0.0, 0.0, 1.0] }",
+            "flow.zones[0].fluid_elastic.mu_lift",
+        ),
+        (
             "{ model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu = 1.0, flow_direction = [2.0, 0.0, 0.0] }",
             "flow.zones[0].fluid_elastic.flow_direction",
         ),
@@ -537,4 +545,324 @@ fn flow_velocity_profile_matches_a_numerical_quadrature() {
             m.effective_velocity
         );
     }
+}
+
+/// Two-phase flow from a thermal-hydraulic map (docs/FLOW.md, "Two-phase flow"): quality `x`
+/// and mass flux `G` give the homogeneous density `ρ_h = 1/(x/ρ_g + (1 − x)/ρ_l)` (the mixture's
+/// specific volume, written here independently of the void fraction), and the zone's gap
+/// velocity carries the mass flux: `ρ_h U_∞ = G` with `U = U_∞ P/(P − D)` (upstream), `ρ_h U = G`
+/// (gap); `x = 0` is the liquid, `x = 1` the gas.
+#[test]
+fn flow_quality_and_mass_flux_give_the_homogeneous_density_and_velocity() {
+    use fretdyn::loads::flow::{homogeneous_density, homogeneous_void_fraction};
+    let (rl, rg, pd) = (740.0, 37.0, 1.44);
+    for (x, definition) in [
+        (0.0, "gap"),
+        (0.05, "upstream"),
+        (0.3, "gap"),
+        (1.0, "upstream"),
+    ] {
+        let g = 500.0;
+        let c = case(&pinned_tube(
+            0.05,
+            &format!(
+                "\n[flow]\npattern = \"rotated_square\"\npitch_ratio = {pd}\nvelocity_definition = \"{definition}\"\n\n[[flow.zones]]\nname = \"bend\"\nspan = [0.0, {L}]\nquality = {x}\nliquid_density = {rl}\ngas_density = {rg}\nmass_flux = {g}\n"
+            ),
+        ));
+        let zone = &c.flow.as_ref().unwrap().zones[0];
+        let rho_h = 1.0 / (x / rg + (1.0 - x) / rl);
+        assert!(
+            (zone.density / rho_h - 1.0).abs() < 1e-14,
+            "x {x}: ρ {} against {rho_h}",
+            zone.density
+        );
+        let u = zone.velocity.constant().unwrap();
+        let u_inf = if definition == "upstream" {
+            u * (pd - 1.0) / pd
+        } else {
+            u
+        };
+        assert!(
+            (zone.density * u_inf / g - 1.0).abs() < 1e-14,
+            "x {x}: ρU = {} against G = {g}",
+            zone.density * u_inf
+        );
+        // the effective velocity of a uniform zone is its velocity
+        let r = c.stability().unwrap();
+        assert!((r.modes[0].effective_velocity / u - 1.0).abs() < 1e-12);
+    }
+    // limits and the void fraction's definition
+    assert_eq!(homogeneous_void_fraction(0.0, rl, rg), 0.0);
+    assert_eq!(homogeneous_void_fraction(1.0, rl, rg), 1.0);
+    assert_eq!(homogeneous_density(0.0, rl, rg), rl);
+    assert_eq!(homogeneous_density(1.0, rl, rg), rg);
+    // ε is the gas's volume fraction: x/ρ_g over the mixture's specific volume
+    let x = 0.2;
+    let eps = homogeneous_void_fraction(x, rl, rg);
+    let volume = x / rg + (1.0 - x) / rl;
+    assert!((eps - (x / rg) / volume).abs() < 1e-15);
+}
+
+/// A mass-flux profile is a velocity profile `G(s)/ρ`; bad two-phase input names its field.
+#[test]
+fn flow_mass_flux_profile_and_bad_two_phase_input() {
+    let zone = |keys: &str| {
+        pinned_tube(
+            0.05,
+            &format!("{FLOW_HEAD}\n[[flow.zones]]\nname = \"z\"\nspan = [0.0, {L}]\n{keys}\n"),
+        )
+    };
+    let c = case(&zone(
+        "quality = 0.1\nliquid_density = 740.0\ngas_density = 37.0\nmass_flux_profile = [[0.0, 300.0], [1.0, 600.0]]",
+    ));
+    let z = &c.flow.as_ref().unwrap().zones[0];
+    for s in [0.0, 0.25, 0.5, 1.0] {
+        let g = 300.0 + 300.0 * s;
+        assert!((z.density * z.velocity.at(s) / g - 1.0).abs() < 1e-14);
+    }
+    for (keys, field) in [
+        (
+            "quality = 1.5\nliquid_density = 740.0\ngas_density = 37.0\nmass_flux = 500.0",
+            "flow.zones[0].quality",
+        ),
+        (
+            "quality = 0.1\nvoid_fraction = 0.5\nliquid_density = 740.0\ngas_density = 37.0\nmass_flux = 500.0",
+            "flow.zones[0].quality",
+        ),
+        (
+            "density = 740.0\nmass_flux = -5.0",
+            "flow.zones[0].mass_flux",
+        ),
+        (
+            "density = 740.0\nmass_flux = 5.0\nvelocity = 1.0",
+            "flow.zones[0]",
+        ),
+    ] {
+        assert_eq!(error_field(&zone(keys)), field, "{keys}");
+    }
+}
+
+/// Viscous damping (docs/FLOW.md, "Damping models") recomputed independently: the power
+/// dissipated in the oscillating Stokes layers on the tube (radius `a`) and on a concentric
+/// wall (radius `b`), `μ V²/(2δ)` per unit area for a slip of amplitude `V`, with the slip of
+/// the potential flow in the annulus — the potential `φ = U (A r + B/r) cos θ` solved here from
+/// its two wall conditions, the slip from `∂φ/∂θ` by central differences — integrated over `θ`
+/// by the trapezoidal rule (exact for these trigonometric integrands); `c = 2P/U²`,
+/// `ζ = c/(2mω)`.
+#[test]
+fn flow_viscous_damping_is_the_stokes_layers_dissipation() {
+    use fretdyn::loads::flow_damping::{ViscousDamping, viscous_damping_ratio};
+    let (rho, nu, m, d) = (740.0, 1.2e-7, 0.6, 0.02);
+    let a = 0.5 * d;
+    for (f, ratio) in [
+        (10.0, f64::INFINITY),
+        (10.0, 1.6),
+        (45.0, 1.3),
+        (200.0, 3.0),
+    ] {
+        let w = 2.0 * PI * f;
+        let delta = (2.0 * nu / w).sqrt();
+        let mu = rho * nu;
+        let u = 1.0;
+        let b = a * ratio;
+        // ∂φ/∂r = U cos θ at r = a, 0 at r = b: A − B/a² = 1, A − B/b² = 0
+        let (aa, bb) = if b.is_finite() {
+            let bb = 1.0 / (1.0 / (b * b) - 1.0 / (a * a));
+            (bb / (b * b), bb)
+        } else {
+            (0.0, -a * a)
+        };
+        let phi = |r: f64, th: f64| u * (aa * r + bb / r) * th.cos();
+        let n = 64;
+        let h = 1e-6;
+        let mut power = 0.0;
+        for k in 0..n {
+            let th = 2.0 * PI * k as f64 / n as f64;
+            let tangential = |r: f64| (phi(r, th + h) - phi(r, th - h)) / (2.0 * h * r);
+            // the tube's own tangential velocity is −U sin θ, the outer wall is still
+            let inner = tangential(a) + u * th.sin();
+            power += mu * inner * inner / (2.0 * delta) * a * 2.0 * PI / n as f64;
+            if b.is_finite() {
+                let outer = tangential(b);
+                power += mu * outer * outer / (2.0 * delta) * b * 2.0 * PI / n as f64;
+            }
+        }
+        let c = 2.0 * power / (u * u);
+        let expected = c / (2.0 * m * w);
+        let v = ViscousDamping {
+            density: rho,
+            kinematic_viscosity: nu,
+            confinement: ratio,
+        };
+        let zeta = viscous_damping_ratio(f, &v, d, m);
+        assert!(
+            (zeta / expected - 1.0).abs() < 1e-8,
+            "f {f}, D_e/D {ratio}: ζ_v {zeta} against {expected}"
+        );
+    }
+}
+
+/// `[flow.damping]`: the check's damping is the basis's plus the models' (each reported), the
+/// critical velocity scales as `√δ` of the total, squeeze film as `1/f`; `in_run` adds the
+/// fluid's terms to the run's damping without counting them twice in the check.
+#[test]
+fn flow_damping_models_add_to_the_connors_check() {
+    let zone =
+        "\n[[flow.zones]]\nname = \"all\"\nspan = [0.0, 1.0]\ndensity = 740.0\nvelocity = 1.0\n";
+    let models = "\n[flow.damping]\nviscous = { density = 740.0, kinematic_viscosity = 1.2e-7, confinement = 1.5 }\ntwo_phase = 0.01\nfriction = 0.004\nsqueeze_film = { ratio = 0.02, frequency = 30.0 }\n";
+    let plain = case(&pinned_tube(0.05, &format!("{FLOW_HEAD}{zone}")))
+        .stability()
+        .unwrap();
+    let with = case(&pinned_tube(0.05, &format!("{FLOW_HEAD}{models}{zone}")));
+    let r = with.stability().unwrap();
+    for (a, b) in plain.modes.iter().zip(&r.modes) {
+        let t = b.damping_terms.expect("the terms of each mode");
+        assert_eq!(t.basis, 0.02);
+        assert_eq!(t.two_phase, Some(0.01));
+        assert_eq!(t.friction, Some(0.004));
+        let sf = t.squeeze_film.unwrap();
+        assert!((sf * b.frequency_hz / (0.02 * 30.0) - 1.0).abs() < 1e-14);
+        let total = 0.02 + t.viscous.unwrap() + 0.01 + 0.004 + sf;
+        assert!((b.damping_ratio / total - 1.0).abs() < 1e-15);
+        // U_c ∝ √δ: the same mode, frequency, density and mass
+        let scale = (b.damping_ratio / a.damping_ratio).sqrt();
+        assert!(
+            (b.critical_velocity / (a.critical_velocity * scale) - 1.0).abs() < 1e-13,
+            "mode {}: {} against {}",
+            b.mode,
+            b.critical_velocity,
+            a.critical_velocity * scale
+        );
+        assert!(a.damping_terms.is_none());
+    }
+    let json = serde_json::to_string(&r).unwrap();
+    assert!(json.contains("\"damping_terms\":{\"basis\":0.02,\"viscous\":"));
+    assert!(
+        !serde_json::to_string(&plain)
+            .unwrap()
+            .contains("damping_terms")
+    );
+    // in_run: the run's damping gains the viscous and two-phase terms; the check is unchanged
+    let run = case(&pinned_tube(
+        0.05,
+        &format!("{FLOW_HEAD}{models}in_run = true\n{zone}"),
+    ));
+    let checked = run.stability().unwrap();
+    for (i, (m, n)) in checked.modes.iter().zip(&r.modes).enumerate() {
+        assert_eq!(m.damping_ratio, n.damping_ratio);
+        let t = m.damping_terms.unwrap();
+        assert_eq!(t.basis, 0.02);
+        assert_eq!(
+            run.model.basis.damping_ratio[i],
+            0.02 + (t.viscous.unwrap() + 0.01)
+        );
+        assert_eq!(with.model.basis.damping_ratio[i], 0.02);
+    }
+}
+
+#[test]
+fn flow_damping_bad_input_names_the_field() {
+    let zone =
+        "\n[[flow.zones]]\nname = \"all\"\nspan = [0.0, 1.0]\ndensity = 740.0\nvelocity = 1.0\n";
+    for (models, field) in [
+        ("two_phase = -0.01", "flow.damping.two_phase"),
+        ("friction = nan", "flow.damping.friction"),
+        (
+            "viscous = { density = 740.0, kinematic_viscosity = 1.2e-7, confinement = 0.9 }",
+            "flow.damping.viscous.confinement",
+        ),
+        (
+            "viscous = { density = 740.0, kinematic_viscosity = 0.0 }",
+            "flow.damping.viscous.kinematic_viscosity",
+        ),
+        (
+            "squeeze_film = { ratio = 0.01, frequency = 0.0 }",
+            "flow.damping.squeeze_film.frequency",
+        ),
+    ] {
+        let text = pinned_tube(
+            0.05,
+            &format!("{FLOW_HEAD}\n[flow.damping]\n{models}\n{zone}"),
+        );
+        assert_eq!(error_field(&text), field, "{models}");
+    }
+}
+
+/// A U-bend's coefficients by plane (`in_plane`, `out_of_plane`) are the lift's and drag's
+/// the flow's direction makes them: flow normal to the bend's plane (examples/ubend_flow.toml,
+/// the bend in xz, flow along y): the lift is in-plane; flow in the plane (along z, over the
+/// apex): the drag is in-plane. The modal matrices equal, bit for bit, those of the explicit
+/// keys. A straight zone, or a flow oblique to the plane, is refused.
+#[test]
+fn flow_u_bend_coefficients_by_plane_resolve_into_lift_and_drag() {
+    let text = std::fs::read_to_string("../../examples/ubend_flow.toml").unwrap();
+    let old = "fluid_elastic = { model = \"quasi_steady\", lift_slope = -3.0, drag = 1.0, mu = 1.0, flow_direction = [0.0, 1.0, 0.0], delay_segments = 4 }";
+    assert!(text.contains(old));
+    let with = |fe: &str, span: &str| {
+        let t = text.replace(old, fe);
+        let t = if span.is_empty() {
+            t
+        } else {
+            t.replace(
+                "from = \"cold_leg_plate\"\nto = \"hot_leg_plate\"",
+                &format!("span = {span}"),
+            )
+        };
+        Case::from_toml_str(&t, Path::new("../../examples"))
+    };
+    let fe = |keys: &str, dir: &str| {
+        format!(
+            "fluid_elastic = {{ model = \"quasi_steady\", {keys}, drag = 1.0, flow_direction = {dir} }}"
+        )
+    };
+    let planes = "in_plane = { slope = -3.0, mu = 1.0 }, out_of_plane = { slope = -1.0, mu = 0.5 }";
+    for (dir, span, explicit) in [
+        (
+            "[0.0, 1.0, 0.0]",
+            "",
+            "lift_slope = -3.0, mu_lift = 1.0, drag_slope = -1.0, mu_drag = 0.5",
+        ),
+        (
+            "[0.0, 0.0, 1.0]",
+            "[2.6, 2.97]",
+            "lift_slope = -1.0, mu_lift = 0.5, drag_slope = -3.0, mu_drag = 1.0",
+        ),
+    ] {
+        let a = with(&fe(planes, dir), span).unwrap_or_else(|e| panic!("{e}"));
+        let b = with(&fe(explicit, dir), span).unwrap_or_else(|e| panic!("{e}"));
+        let (fa, fb) = (
+            a.model.fluid_elastic.unwrap(),
+            b.model.fluid_elastic.unwrap(),
+        );
+        assert_eq!(fa, fb, "flow {dir}");
+        // and not the other assignment
+        let swapped = if explicit.starts_with("lift_slope = -3.0") {
+            "lift_slope = -1.0, mu_lift = 0.5, drag_slope = -3.0, mu_drag = 1.0"
+        } else {
+            "lift_slope = -3.0, mu_lift = 1.0, drag_slope = -1.0, mu_drag = 0.5"
+        };
+        let c = with(&fe(swapped, dir), span).unwrap();
+        assert_ne!(fa, c.model.fluid_elastic.unwrap(), "flow {dir}");
+    }
+    for (dir, span, field) in [
+        (
+            "[0.0, 1.0, 1.0]",
+            "",
+            "flow.zones[1].fluid_elastic.flow_direction",
+        ),
+        (
+            "[0.0, 1.0, 0.0]",
+            "[0.2, 1.8]",
+            "flow.zones[1].fluid_elastic.in_plane",
+        ),
+    ] {
+        let e = with(&fe(planes, dir), span).expect_err("refused");
+        assert_eq!(e.field(), Some(field), "{e}");
+    }
+    let e = with(
+        &fe(&format!("{planes}, lift_slope = -3.0"), "[0.0, 1.0, 0.0]"),
+        "",
+    )
+    .expect_err("both ways refused");
+    assert_eq!(e.field(), Some("flow.zones[1].fluid_elastic.in_plane"));
 }

@@ -195,35 +195,42 @@ fn zone_rows() -> Vec<Vec<f64>> {
 }
 
 fn nodes(rows: &[Vec<f64>], u: f64) -> Vec<FlowNode<'_>> {
-    rows.iter()
-        .map(|r| FlowNode {
-            weight: 1.0 / NODES as f64,
-            density: RHO,
-            velocity: u,
-            delay: QS.mu * D / u,
-            diameter: D,
-            lift: Vector3::y(),
-            drag: Vector3::x(),
-            rows: r,
-        })
-        .collect()
+    directed_nodes(rows, u, &QS)
 }
 
 const QS: QuasiSteady = QuasiSteady {
     lift_slope: -3.0,
     drag_slope: 0.0,
     drag: 1.0,
-    mu: 1.0,
+    mu_lift: 1.0,
+    mu_drag: 1.0,
 };
 
-/// σ of the linear theory at velocity `u`: `k = ½ρU² C_L' a`, `c = ½ρUD C_D a`,
-/// `τ = μD/U`, with `a = Σ w φ²` computed here.
-fn linear_sigma(u: f64) -> f64 {
+/// `(σ, ω)` of the linear theory of the mode across the flow at velocity `u` with the
+/// coefficients `qs`: `k = ½ρU² C_L' a`, `c = ½ρUD C_D a`, `τ = μ_L D/U`, with
+/// `a = Σ w φ²` computed here.
+fn lift_root(qs: &QuasiSteady, u: f64) -> (f64, f64) {
     let a: f64 = (0..NODES).map(|i| shape(i).powi(2) / NODES as f64).sum();
     let w0 = std::f64::consts::TAU * F0;
-    let k = 0.5 * RHO * u * u * QS.lift_slope * a;
-    let c = 0.5 * RHO * u * D * QS.drag * a;
-    characteristic_root(2.0 * ZETA * w0 + c, w0 * w0, k, QS.mu * D / u).0
+    let k = 0.5 * RHO * u * u * qs.lift_slope * a;
+    let c = 0.5 * RHO * u * D * qs.drag * a;
+    characteristic_root(2.0 * ZETA * w0 + c, w0 * w0, k, qs.mu_lift * D / u)
+}
+
+fn linear_sigma(u: f64) -> f64 {
+    lift_root(&QS, u).0
+}
+
+/// The run's `(σ, ω)` against the root's, within 1e-3 of each.
+fn assert_rate((ms, mw): (f64, f64), (sigma, omega): (f64, f64), u: f64) {
+    assert!(
+        (ms - sigma).abs() <= 1e-3 * sigma.abs(),
+        "U {u}: σ {ms} against {sigma}"
+    );
+    assert!(
+        (mw - omega).abs() <= 1e-3 * omega,
+        "U {u}: ω {mw} against {omega}"
+    );
 }
 
 fn run_sigma(u: f64) -> f64 {
@@ -247,44 +254,121 @@ fn threshold(mut lo: f64, mut hi: f64, sigma: impl Fn(f64) -> f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// The first velocity below `max` where the linear σ crosses 0 (bracketed on a grid of
+/// 0.01 m/s), by bisection on the linear theory and on the runs: they must agree within 1 %.
+/// Returns the linear one.
+fn same_threshold(max: f64, linear: impl Fn(f64) -> f64, runs: impl Fn(f64) -> f64) -> f64 {
+    let grid: Vec<f64> = (1..=(max / 0.01).round() as usize)
+        .map(|i| 0.01 * i as f64)
+        .collect();
+    let i = grid
+        .windows(2)
+        .position(|w| linear(w[0]) < 0.0 && linear(w[1]) > 0.0)
+        .unwrap_or_else(|| panic!("an instability below {max} m/s"));
+    let (lo, hi) = (grid[i], grid[i + 1]);
+    let theory = threshold(lo, hi, &linear);
+    let measured = threshold(lo, hi, runs);
+    eprintln!("threshold: runs {measured} m/s, linear theory {theory} m/s");
+    assert!(
+        (measured - theory).abs() <= 0.01 * theory,
+        "threshold from runs {measured} m/s against {theory} m/s"
+    );
+    theory
+}
+
 #[test]
 fn quasi_steady_model_matches_the_linear_theory_and_its_threshold() {
     // below and above the threshold: σ and ω of the runs against the roots
     for u in [0.05, 0.3] {
         let rows = zone_rows();
         let fe = FluidElastic::quasi_steady("zone", &QS, &nodes(&rows, u), 1);
-        let (ms, mw) = run_rate(fe, 2e-5, 4.0, 1.5);
-        let a: f64 = (0..NODES).map(|i| shape(i).powi(2) / NODES as f64).sum();
-        let w0 = std::f64::consts::TAU * F0;
-        let (sigma, omega) = characteristic_root(
-            2.0 * ZETA * w0 + 0.5 * RHO * u * D * QS.drag * a,
-            w0 * w0,
-            0.5 * RHO * u * u * QS.lift_slope * a,
-            QS.mu * D / u,
-        );
-        assert!(
-            (ms - sigma).abs() <= 1e-3 * sigma.abs(),
-            "U {u}: σ {ms} against {sigma}"
-        );
-        assert!(
-            (mw - omega).abs() <= 1e-3 * omega,
-            "U {u}: ω {mw} against {omega}"
-        );
+        assert_rate(run_rate(fe, 2e-5, 4.0, 1.5), lift_root(&QS, u), u);
     }
-    // the first velocity where the linear σ crosses 0, bracketed on a grid
-    let grid: Vec<f64> = (1..=60).map(|i| 0.01 * i as f64).collect();
-    let i = grid
-        .windows(2)
-        .position(|w| linear_sigma(w[0]) < 0.0 && linear_sigma(w[1]) > 0.0)
-        .expect("an instability below 0.6 m/s");
-    let (lo, hi) = (grid[i], grid[i + 1]);
-    let linear = threshold(lo, hi, linear_sigma);
-    let runs = threshold(lo, hi, run_sigma);
-    eprintln!("threshold: runs {runs} m/s, linear theory {linear} m/s");
+    same_threshold(0.6, linear_sigma, run_sigma);
+}
+
+/// Coefficients of a streamwise (drag-direction) instability, each direction with its own
+/// delay factor: `C_D' < 0` with `μ_D` feeds a motion along the flow; the lift terms differ
+/// (`C_L'`, `μ_L`) so that a test sees which ones act.
+const QS_DRAG: QuasiSteady = QuasiSteady {
+    lift_slope: -1.0,
+    drag_slope: -3.0,
+    drag: 0.5,
+    mu_lift: 0.4,
+    mu_drag: 1.0,
+};
+
+/// The zone's nodes for the mode `φ` along `direction` (x: along the flow, y: across it).
+fn directed_nodes<'a>(rows: &'a [Vec<f64>], u: f64, qs: &QuasiSteady) -> Vec<FlowNode<'a>> {
+    rows.iter()
+        .map(|r| FlowNode {
+            weight: 1.0 / NODES as f64,
+            density: RHO,
+            velocity: u,
+            delay_lift: qs.mu_lift * D / u,
+            delay_drag: qs.mu_drag * D / u,
+            diameter: D,
+            lift: Vector3::y(),
+            drag: Vector3::x(),
+            rows: r,
+        })
+        .collect()
+}
+
+/// Rows of the mode `√2 sin(πs)` along the flow (x).
+fn streamwise_rows() -> Vec<Vec<f64>> {
+    (0..NODES).map(|i| vec![shape(i), 0.0, 0.0]).collect()
+}
+
+/// σ of the linear theory of a mode moving along the flow: `k = ½ρU² C_D' a`,
+/// `c = ρUD C_D a` (the drag's damping is twice the lift's), `τ = μ_D D/U`.
+fn streamwise_sigma(u: f64) -> f64 {
+    let a: f64 = (0..NODES).map(|i| shape(i).powi(2) / NODES as f64).sum();
+    let w0 = std::f64::consts::TAU * F0;
+    let k = 0.5 * RHO * u * u * QS_DRAG.drag_slope * a;
+    let c = RHO * u * D * QS_DRAG.drag * a;
+    characteristic_root(2.0 * ZETA * w0 + c, w0 * w0, k, QS_DRAG.mu_drag * D / u).0
+}
+
+fn streamwise_run_sigma(u: f64) -> f64 {
+    let rows = streamwise_rows();
+    let fe = FluidElastic::quasi_steady("zone", &QS_DRAG, &directed_nodes(&rows, u, &QS_DRAG), 1);
+    run_rate(fe, 2e-5, 4.0, 1.5).0
+}
+
+#[test]
+fn streamwise_motion_goes_unstable_at_the_drag_coefficients_threshold() {
+    let linear = same_threshold(0.8, streamwise_sigma, streamwise_run_sigma);
+    // the lift's coefficients alone would give another threshold: the drag's are the ones used
+    let lift_sigma = |u: f64| lift_root(&QS_DRAG, u).0;
+    // at the streamwise threshold the lift's theory is far from neutral (more than a tenth of
+    // the structural decay rate ζω₀ away from σ = 0)
+    let w0 = std::f64::consts::TAU * F0;
     assert!(
-        (runs - linear).abs() <= 0.01 * linear,
-        "threshold from runs {runs} m/s against {linear} m/s"
+        lift_sigma(linear).abs() > 0.1 * ZETA * w0,
+        "σ with the lift's coefficients {} at {linear} m/s",
+        lift_sigma(linear)
     );
+}
+
+#[test]
+fn motion_across_the_flow_does_not_see_the_drag_terms() {
+    // the mode across the flow (y), the zone with both directions' coefficients and delays:
+    // the run follows the root with the lift's coefficients and delay only
+    let rows = zone_rows();
+    for u in [0.1, 0.6] {
+        let fe =
+            FluidElastic::quasi_steady("zone", &QS_DRAG, &directed_nodes(&rows, u, &QS_DRAG), 1);
+        // two delay groups; the drag's holds no stiffness for this mode
+        assert_eq!(fe.delayed.len(), 2, "one group per direction's delay");
+        let drag_group = fe
+            .delayed
+            .iter()
+            .find(|g| g.delay == QS_DRAG.mu_drag * D / u)
+            .unwrap();
+        assert_eq!(drag_group.stiffness, ModalMatrix::Dense(vec![0.0]));
+        assert_rate(run_rate(fe, 2e-5, 4.0, 1.5), lift_root(&QS_DRAG, u), u);
+    }
 }
 
 #[test]

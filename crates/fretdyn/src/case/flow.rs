@@ -5,12 +5,13 @@
 use nalgebra::Vector3;
 use serde::Deserialize;
 
+use super::flow_damping::DampingSection;
 use super::shared::{Abscissae, TubeModel, point_index};
 use crate::error::{Error, Result, number};
 use crate::loads::flow::ZoneFluidElastic;
 use crate::loads::flow::{
     Bundle, BundlePattern, Flow, FlowZone, Station, VelocityDefinition, VelocityProfile,
-    midpoint_weights,
+    homogeneous_density, homogeneous_void_fraction, midpoint_weights,
 };
 use crate::loads::fluid_elastic::{QuasiSteady, ReducedVelocityTable};
 use crate::model::Model;
@@ -31,6 +32,8 @@ pub(super) struct FlowSection {
     /// Default: the tube's mass per unit length (tube, inner fluid, added mass).
     mass_per_length: Option<f64>,
     zones: Vec<ZoneSection>,
+    /// The damping models of the check.
+    damping: Option<DampingSection>,
 }
 
 fn default_connors_constant() -> f64 {
@@ -47,11 +50,17 @@ struct ZoneSection {
     to: Option<String>,
     density: Option<f64>,
     void_fraction: Option<f64>,
+    /// Steam quality `x` (mass fraction of gas): the homogeneous void fraction.
+    quality: Option<f64>,
     liquid_density: Option<f64>,
     gas_density: Option<f64>,
     velocity: Option<f64>,
     /// `[[s, U], ...]`.
     velocity_profile: Option<Vec<[f64; 2]>>,
+    /// `G`, kg/(m² s): the velocity is `G / ρ`.
+    mass_flux: Option<f64>,
+    /// `[[s, G], ...]`.
+    mass_flux_profile: Option<Vec<[f64; 2]>>,
     /// The zone's fluid-elastic forces (THEORY §13).
     fluid_elastic: Option<FluidElasticInput>,
 }
@@ -61,11 +70,16 @@ struct ZoneSection {
 #[serde(tag = "model", rename_all = "snake_case", deny_unknown_fields)]
 enum FluidElasticInput {
     QuasiSteady {
-        lift_slope: f64,
-        #[serde(default)]
-        drag_slope: f64,
+        lift_slope: Option<f64>,
+        drag_slope: Option<f64>,
+        /// A U-bend's coefficients by plane instead of by direction.
+        in_plane: Option<PlaneInput>,
+        out_of_plane: Option<PlaneInput>,
         drag: f64,
-        mu: f64,
+        /// `μ` of both directions, unless `mu_lift` / `mu_drag` give theirs.
+        mu: Option<f64>,
+        mu_lift: Option<f64>,
+        mu_drag: Option<f64>,
         flow_direction: [f64; 3],
         #[serde(default = "default_delay_segments")]
         delay_segments: usize,
@@ -75,6 +89,16 @@ enum FluidElasticInput {
         damping: Vec<f64>,
         stiffness: Vec<f64>,
     },
+}
+
+/// `in_plane = { slope, mu }` / `out_of_plane = { slope, mu }`: a planar zone's quasi-steady
+/// stiffness coefficient and delay factor by plane, resolved into lift and drag by the flow's
+/// direction against the zone's plane.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlaneInput {
+    slope: f64,
+    mu: Option<f64>,
 }
 
 fn default_delay_segments() -> usize {
@@ -101,29 +125,15 @@ impl FluidElasticInput {
             FluidElasticInput::QuasiSteady {
                 lift_slope,
                 drag_slope,
+                in_plane,
+                out_of_plane,
                 drag,
                 mu,
+                mu_lift,
+                mu_drag,
                 flow_direction,
                 delay_segments,
             } => {
-                finite(*lift_slope, "lift_slope")?;
-                finite(*drag_slope, "drag_slope")?;
-                finite(*drag, "drag")?;
-                if !(mu.is_finite() && *mu >= 0.0) {
-                    return Err(Error::invalid(
-                        format!("{field}.mu"),
-                        format!(
-                            "must be a number ≥ 0, the time-lag factor of τ = μ D / U (got {})",
-                            number(*mu)
-                        ),
-                    ));
-                }
-                if *delay_segments == 0 {
-                    return Err(Error::invalid(
-                        format!("{field}.delay_segments"),
-                        "must be at least 1",
-                    ));
-                }
                 let d = Vector3::from(*flow_direction);
                 if !(d.iter().all(|v| v.is_finite()) && d.norm() > 0.0) {
                     return Err(Error::invalid(
@@ -132,6 +142,81 @@ impl FluidElasticInput {
                     ));
                 }
                 let d = d.normalize();
+                // by plane: resolved into lift and drag (the absent plane: no stiffness, the
+                // other's delay)
+                let by_plane = in_plane.is_some() || out_of_plane.is_some();
+                let (lift_slope, drag_slope, mu_lift, mu_drag) = if by_plane {
+                    if lift_slope.is_some()
+                        || drag_slope.is_some()
+                        || mu_lift.is_some()
+                        || mu_drag.is_some()
+                    {
+                        return Err(Error::invalid(
+                            format!("{field}.in_plane"),
+                            "give the coefficients either by plane (in_plane, out_of_plane) or by direction (lift_slope, drag_slope, mu_lift, mu_drag), not both",
+                        ));
+                    }
+                    let flow_in_plane = flow_in_zone_plane(field, stations, &d)?;
+                    let pick = |p: &Option<PlaneInput>, other: &Option<PlaneInput>| {
+                        let mu_other = other.as_ref().and_then(|o| o.mu).or(*mu);
+                        match p {
+                            Some(p) => (Some(p.slope), p.mu.or(*mu)),
+                            None => (Some(0.0), mu_other),
+                        }
+                    };
+                    let (inp, out) = (pick(in_plane, out_of_plane), pick(out_of_plane, in_plane));
+                    // flow in the plane: the drag is in-plane, the lift out of plane
+                    let (lift, drag) = if flow_in_plane {
+                        (out, inp)
+                    } else {
+                        (inp, out)
+                    };
+                    (lift.0, drag.0, lift.1, drag.1)
+                } else {
+                    (*lift_slope, *drag_slope, *mu_lift, *mu_drag)
+                };
+                let Some(lift_slope) = lift_slope else {
+                    return Err(Error::invalid(
+                        format!("{field}.lift_slope"),
+                        "is missing: give lift_slope (and drag_slope), or in_plane/out_of_plane for a planar zone",
+                    ));
+                };
+                let drag_slope = drag_slope.unwrap_or(0.0);
+                finite(lift_slope, "lift_slope")?;
+                finite(drag_slope, "drag_slope")?;
+                finite(*drag, "drag")?;
+                // each direction's μ: its own key, else `mu`
+                let lag = |own: Option<f64>, key: &str| -> Result<f64> {
+                    let (v, key) = match (own, mu) {
+                        (Some(v), _) => (v, key),
+                        (None, Some(v)) => (*v, "mu"),
+                        (None, None) => {
+                            return Err(Error::invalid(
+                                format!("{field}.{key}"),
+                                "is missing: give mu (the time-lag factor of τ = μ D / U for both directions) or both mu_lift and mu_drag",
+                            ));
+                        }
+                    };
+                    if v.is_finite() && v >= 0.0 {
+                        Ok(v)
+                    } else {
+                        Err(Error::invalid(
+                            format!("{field}.{key}"),
+                            format!(
+                                "must be a number ≥ 0, the time-lag factor of τ = μ D / U (got {})",
+                                number(v)
+                            ),
+                        ))
+                    }
+                };
+                let mu_lift = lag(mu_lift, "mu_lift")?;
+                let mu_drag = lag(mu_drag, "mu_drag")?;
+                if *delay_segments == 0 {
+                    return Err(Error::invalid(
+                        format!("{field}.delay_segments"),
+                        "must be at least 1",
+                    ));
+                }
                 if let Some(st) = stations
                     .iter()
                     .find(|st| (d - st.tangent * d.dot(&st.tangent)).norm() < 1e-6)
@@ -146,10 +231,11 @@ impl FluidElasticInput {
                 }
                 Ok(ZoneFluidElastic::QuasiSteady {
                     coefficients: QuasiSteady {
-                        lift_slope: *lift_slope,
-                        drag_slope: *drag_slope,
+                        lift_slope,
+                        drag_slope,
                         drag: *drag,
-                        mu: *mu,
+                        mu_lift,
+                        mu_drag,
                     },
                     flow_direction: d,
                     delay_segments: *delay_segments,
@@ -193,6 +279,39 @@ impl FluidElasticInput {
                 }))
             }
         }
+    }
+}
+
+/// Whether the flow `d` lies in the plane of the zone's axis (`true`) or is normal to it
+/// (`false`); an error on `{field}.in_plane` when the zone is straight or not planar, on
+/// `{field}.flow_direction` when the flow is neither.
+fn flow_in_zone_plane(field: &str, stations: &[Station], d: &Vector3<f64>) -> Result<bool> {
+    let t0 = stations.first().map_or(Vector3::zeros(), |s| s.tangent);
+    let normal = stations
+        .iter()
+        .map(|s| t0.cross(&s.tangent))
+        .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+        .unwrap_or(Vector3::zeros());
+    let planar = normal.norm() > 1e-6 && {
+        let n = normal.normalize();
+        stations.iter().all(|s| s.tangent.dot(&n).abs() < 1e-6)
+    };
+    if !planar {
+        return Err(Error::invalid(
+            format!("{field}.in_plane"),
+            "the zone's axis is straight or not planar, so it has no plane: give lift_slope and drag_slope (across and along the flow)",
+        ));
+    }
+    let n = normal.normalize();
+    if d.dot(&n).abs() < 1e-6 {
+        Ok(true)
+    } else if d.cross(&n).norm() < 1e-6 {
+        Ok(false)
+    } else {
+        Err(Error::invalid(
+            format!("{field}.flow_direction"),
+            "lies neither in the zone's plane nor normal to it: in_plane/out_of_plane cannot name the lift and drag; give lift_slope and drag_slope",
+        ))
     }
 }
 
@@ -320,6 +439,7 @@ impl FlowSection {
             connors_constant: self.connors_constant,
             zones: zones.into_iter().map(|(_, z)| z).collect(),
             whole,
+            damping: self.damping.as_ref().map(|d| d.build()).transpose()?,
         })
     }
 }
@@ -477,24 +597,31 @@ impl ZoneSection {
         }
         let (s0, s1) = (s0.max(lo), s1.min(hi));
         let density = self.density(field)?;
-        let velocity = match (self.velocity, &self.velocity_profile) {
-            (Some(u), None) => VelocityProfile::Constant(u),
-            (None, Some(rows)) => VelocityProfile::Table {
-                s: rows.iter().map(|r| r[0]).collect(),
-                velocity: rows.iter().map(|r| r[1]).collect(),
-            },
+        let profile = |rows: &Vec<[f64; 2]>, scale: f64| VelocityProfile::Table {
+            s: rows.iter().map(|r| r[0]).collect(),
+            velocity: rows.iter().map(|r| r[1] * scale).collect(),
+        };
+        let given = (
+            self.velocity,
+            &self.velocity_profile,
+            self.mass_flux,
+            &self.mass_flux_profile,
+        );
+        let (velocity, key) = match given {
+            (Some(u), None, None, None) => (VelocityProfile::Constant(u), "velocity"),
+            (None, Some(rows), None, None) => (profile(rows, 1.0), "velocity_profile"),
+            // U = G / ρ: the mass flux is referred to the same section as the velocity
+            // (velocity_definition), the density is the zone's (homogeneous) one
+            (None, None, Some(g), None) => (VelocityProfile::Constant(g / density), "mass_flux"),
+            (None, None, None, Some(rows)) => (profile(rows, 1.0 / density), "mass_flux_profile"),
             _ => {
                 return Err(Error::invalid(
                     field,
-                    "give either velocity = U (m/s) or velocity_profile = [[s, U], ...] (m, m/s; linear in s)",
+                    "give one of velocity = U (m/s), velocity_profile = [[s, U], ...] (m, m/s; linear in s), mass_flux = G (kg/(m² s); U = G/ρ) or mass_flux_profile = [[s, G], ...]",
                 ));
             }
         };
-        let vfield = if self.velocity.is_some() {
-            format!("{field}.velocity")
-        } else {
-            format!("{field}.velocity_profile")
-        };
+        let vfield = format!("{field}.{key}");
         // as given, then as gap velocities (an upstream velocity times P/(P − D) may overflow)
         velocity.validate(&vfield)?;
         let velocity = velocity.scaled(factor);
@@ -540,27 +667,38 @@ impl ZoneSection {
                 ))
             }
         };
-        match (
-            self.density,
-            self.void_fraction,
-            self.liquid_density,
-            self.gas_density,
-        ) {
+        let alpha = match (self.void_fraction, self.quality) {
+            (Some(a), None) => Some((a, "void_fraction")),
+            (None, Some(x)) => Some((x, "quality")),
+            (None, None) => None,
+            (Some(_), Some(_)) => {
+                return Err(Error::invalid(
+                    format!("{field}.quality"),
+                    "give either void_fraction or quality (the homogeneous void fraction follows from it), not both",
+                ));
+            }
+        };
+        match (self.density, alpha, self.liquid_density, self.gas_density) {
             (Some(rho), None, None, None) => check(rho, "density", "a fluid density > 0 in kg/m³"),
-            (None, Some(alpha), Some(rl), Some(rg)) => {
-                if !(alpha.is_finite() && (0.0..=1.0).contains(&alpha)) {
+            (None, Some((a, key)), Some(rl), Some(rg)) => {
+                if !(a.is_finite() && (0.0..=1.0).contains(&a)) {
                     return Err(Error::invalid(
-                        format!("{field}.void_fraction"),
-                        format!("must be in [0, 1] (got {})", number(alpha)),
+                        format!("{field}.{key}"),
+                        format!("must be in [0, 1] (got {})", number(a)),
                     ));
                 }
                 let rl = check(rl, "liquid_density", "a density > 0 in kg/m³")?;
                 let rg = check(rg, "gas_density", "a density > 0 in kg/m³")?;
-                Ok((1.0 - alpha) * rl + alpha * rg)
+                let alpha = if key == "quality" {
+                    homogeneous_void_fraction(a, rl, rg)
+                } else {
+                    a
+                };
+                Ok(homogeneous_density(alpha, rl, rg))
             }
             _ => Err(Error::invalid(
                 field,
-                "give either density = ρ (kg/m³) or void_fraction, liquid_density and gas_density (homogeneous two-phase density (1 − α) ρ_l + α ρ_g)",
+                "give either density = ρ (kg/m³) or void_fraction (or quality), liquid_density and gas_density (homogeneous two-phase density (1 − α) ρ_l + α ρ_g)",
             )),
         }
     }

@@ -12,7 +12,7 @@
 //!   in `wear`);
 //! - `loads`: `[[loads]]`, `[[modal_loads]]`, `[[line_loads]]`, `[[turbulence]]`,
 //!   `[base_excitation]`;
-//! - `flow`: `[flow]` and its `[[flow.zones]]`;
+//! - `flow`: `[flow]` and its `[[flow.zones]]`; `flow_damping`: `[flow.damping]`;
 //! - `settings`: `[time]`, `[tangential]`, `[output]`, `[statistics]`;
 //! - `life`: `[life]`, the service life of `fretdyn life`;
 //! - `stability`: `[stability]`, the support conditions of the Connors check.
@@ -27,6 +27,7 @@ mod contacts;
 pub mod fingerprint;
 mod flat_bar;
 mod flow;
+mod flow_damping;
 pub mod key_path;
 mod life;
 mod loads;

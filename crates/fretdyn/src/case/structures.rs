@@ -97,10 +97,18 @@ impl StructureParts<'_> {
         basis.validate("structure")?;
         let mut model = Model::new(basis);
         build_contacts(self.contacts, &|_| tube.as_deref(), &mut model)?;
-        let flow = match self.flow {
+        let mut flow = match self.flow {
             Some(f) => Some(Box::new(f.build(tube.as_deref(), &abscissae, &model)?)),
             None => None,
         };
+        // `[flow.damping] in_run`: the fluid's damping terms join the run's modal damping
+        if let Some(f) = &mut flow {
+            let (d, m) = (f.diameter, f.mass_per_length);
+            if let Some(damping) = &mut f.damping {
+                let basis = &mut model.basis;
+                damping.add_to_run(&basis.omega, &mut basis.damping_ratio, d, m);
+            }
+        }
         let loads = LoadSections {
             loads: self.loads,
             modal_loads: self.modal_loads,

@@ -24,6 +24,7 @@
 
 use nalgebra::Vector3;
 
+use crate::loads::flow_damping::{DampingModels, DampingTerms};
 use crate::loads::fluid_elastic::{FlowNode, FluidElastic, QuasiSteady, ReducedVelocityTable};
 use serde::{Deserialize, Serialize};
 
@@ -177,6 +178,18 @@ impl VelocityProfile {
     }
 }
 
+/// Homogeneous void fraction of a two-phase flow of steam quality `x` (mass fraction of gas),
+/// liquid and gas densities `ρ_l`, `ρ_g` (no slip between the phases):
+/// `ε = x ρ_l / (x ρ_l + (1 − x) ρ_g)` (docs/FLOW.md, "Two-phase flow").
+pub fn homogeneous_void_fraction(quality: f64, liquid: f64, gas: f64) -> f64 {
+    quality * liquid / (quality * liquid + (1.0 - quality) * gas)
+}
+
+/// Homogeneous density `ρ_h = ε ρ_g + (1 − ε) ρ_l` of void fraction `ε`, kg/m³.
+pub fn homogeneous_density(void_fraction: f64, liquid: f64, gas: f64) -> f64 {
+    (1.0 - void_fraction) * liquid + void_fraction * gas
+}
+
 /// Quadrature weights of stations at the sorted abscissae `s` covering `[a, b]` (a midpoint
 /// rule: each station carries from the midpoint with its neighbour before to the one after,
 /// the first from `a`, the last to `b`).
@@ -200,7 +213,7 @@ pub fn midpoint_weights(s: &[f64], a: f64, b: f64) -> Vec<f64> {
 pub enum ZoneFluidElastic {
     /// The quasi-steady model with a time lag.
     QuasiSteady {
-        /// `C_L'`, `C_D'`, `C_D`, `μ`.
+        /// `C_L'`, `C_D'`, `C_D`, `μ_L`, `μ_D`.
         coefficients: QuasiSteady,
         /// Direction of the flow (drag); the lift is across it and the tube's axis.
         flow_direction: Vector3<f64>,
@@ -259,6 +272,8 @@ pub struct Flow {
     pub zones: Vec<FlowZone>,
     /// Stations over the whole tube (the denominator `∫ φ² ds` of `U_eff²`).
     pub whole: Vec<Station>,
+    /// The damping models added to the basis's damping in the check (`[flow.damping]`).
+    pub damping: Option<DampingModels>,
 }
 
 /// `U_c = K f D √(m δ / (ρ D²))`, `δ = 2π ζ` (Connors; Pettigrew & Taylor 2003): the critical
@@ -288,6 +303,9 @@ pub struct ModeStability {
     pub critical_velocity: f64,
     /// `U_eff / U_c`; `None` when undefined (`U_eff = U_c = 0`).
     pub ratio: Option<f64>,
+    /// The terms of `damping_ratio` (their sum), with `[flow.damping]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping_terms: Option<DampingTerms>,
     /// The support condition of the mode: `support_inactive` (the basis's modes), or the
     /// name of a `[[stability.conditions]]` (docs/FLOW.md).
     pub condition: String,
@@ -442,7 +460,12 @@ impl Flow {
                     0.0
                 };
                 let f = basis.omega[i] / std::f64::consts::TAU;
-                let zeta = basis.damping_ratio[i];
+                // the basis's damping, plus the models' ([flow.damping])
+                let damping_terms = self.damping.as_ref().map(|d| {
+                    let zeta = basis.damping_ratio[i];
+                    d.terms(i, zeta, f, self.diameter, self.mass_per_length)
+                });
+                let zeta = damping_terms.map_or(basis.damping_ratio[i], |t| t.total());
                 let critical = connors_critical_velocity(
                     f,
                     zeta,
@@ -469,6 +492,7 @@ impl Flow {
                     condition: condition.to_string(),
                     plane: out_of_plane_share.map(Plane::of_share),
                     out_of_plane_share,
+                    damping_terms,
                 }
             })
             .collect();
@@ -540,8 +564,11 @@ impl Flow {
                     coefficients,
                     flow_direction,
                     ..
-                } => (coefficients.mu, *flow_direction),
-                ZoneFluidElastic::Table(_) => (0.0, Vector3::zeros()),
+                } => (
+                    [coefficients.mu_lift, coefficients.mu_drag],
+                    *flow_direction,
+                ),
+                ZoneFluidElastic::Table(_) => ([0.0; 2], Vector3::zeros()),
             };
             let nodes: Vec<FlowNode> = zone
                 .stations
@@ -557,15 +584,19 @@ impl Flow {
                         zone.velocity.at(mid)
                     };
                     let (lift, drag) = cross_flow_axes(&st.tangent, &direction);
+                    let delay = |mu: f64| {
+                        if u_delay > 0.0 {
+                            mu * self.diameter / u_delay
+                        } else {
+                            0.0
+                        }
+                    };
                     FlowNode {
                         weight: st.weight,
                         density: zone.density,
                         velocity: u,
-                        delay: if u_delay > 0.0 {
-                            mu * self.diameter / u_delay
-                        } else {
-                            0.0
-                        },
+                        delay_lift: delay(mu[0]),
+                        delay_drag: delay(mu[1]),
                         diameter: self.diameter,
                         lift,
                         drag,

@@ -11,11 +11,12 @@
 //! density `ρ`, velocity `U`, tube diameter `D`,
 //!
 //! ```text
-//! lift  (across the flow): f_y = ½ρU² C_L' y(t − τ) − ½ρUD C_D ẏ
-//! drag  (along the flow):  f_x = ½ρU² C_D' x(t − τ) −  ρUD C_D ẋ,      τ = μ D / U,
+//! lift  (across the flow): f_y = ½ρU² C_L' y(t − τ_L) − ½ρUD C_D ẏ,    τ_L = μ_L D / U
+//! drag  (along the flow):  f_x = ½ρU² C_D' x(t − τ_D) −  ρUD C_D ẋ,    τ_D = μ_D D / U,
 //! ```
 //!
-//! so `K_g = ∫ ½ρU² (C_L' φ_y φ_yᵀ + C_D' φ_x φ_xᵀ) ds` and `C = ∫ ρUD C_D (½ φ_y φ_yᵀ +
+//! so `K_g = ∫ ½ρU² ([τ_L ∈ g] C_L' φ_y φ_yᵀ + [τ_D ∈ g] C_D' φ_x φ_xᵀ) ds` (each direction's
+//! term in the group of its own delay) and `C = ∫ ρUD C_D (½ φ_y φ_yᵀ +
 //! φ_x φ_xᵀ) ds`. Tabulated modal coefficients (the form of Code_Aster and EDF: fluid damping
 //! `c(V_r)` and stiffness `k(V_r)` per unit length against the reduced velocity
 //! `V_r = U / (f_i D)`) give diagonal `C` and `K` with no delay.
@@ -209,10 +210,11 @@ impl FluidElastic {
     }
 
     /// The quasi-steady model with a time lag (Price & Païdoussis; THEORY §13) on the flow
-    /// `nodes` of one zone: per unit length `f_lift = ½ρU² C_L' y(t − τ) − ½ρUD C_D ẏ`,
-    /// `f_drag = ½ρU² C_D' x(t − τ) − ρUD C_D ẋ`, integrated with the nodes' weights, each
-    /// node with its delay [`FlowNode::delay`] (`μ D / U`; one delay group per distinct
-    /// delay). `name` names the zone.
+    /// `nodes` of one zone: per unit length `f_lift = ½ρU² C_L' y(t − τ_L) − ½ρUD C_D ẏ`,
+    /// `f_drag = ½ρU² C_D' x(t − τ_D) − ρUD C_D ẋ`, integrated with the
+    /// nodes' weights, each direction of each node with its delay
+    /// ([`FlowNode::delay_lift`] `μ_L D / U`, [`FlowNode::delay_drag`] `μ_D D / U`; one delay
+    /// group per distinct delay). `name` names the zone.
     pub fn quasi_steady(
         name: &str,
         coefficients: &QuasiSteady,
@@ -230,26 +232,47 @@ impl FluidElastic {
         for n in nodes {
             n.directional_rows(&mut lift, &mut drag);
             let q = 0.5 * n.density * n.velocity * n.velocity * n.weight;
-            k.fill(0.0);
-            add_outer(&mut k, q * coefficients.lift_slope, &lift);
-            add_outer(&mut k, q * coefficients.drag_slope, &drag);
             let c = n.density * n.velocity * n.diameter * coefficients.drag * n.weight;
             add_outer(&mut damping, 0.5 * c, &lift);
             add_outer(&mut damping, c, &drag);
-            match out.delayed.iter_mut().find(|g| g.delay == n.delay) {
-                Some(DelayedStiffness {
-                    stiffness: ModalMatrix::Dense(h),
-                    ..
-                }) => h.iter_mut().zip(&k).for_each(|(h, k)| *h += k),
-                _ => out.delayed.push(DelayedStiffness {
-                    name: name.to_string(),
-                    delay: n.delay,
-                    stiffness: ModalMatrix::Dense(k.clone()),
-                }),
+            if n.delay_lift == n.delay_drag {
+                // one delay: both directions' stiffness in one group (as before per-direction
+                // delays existed, so that such cases keep their bits)
+                k.fill(0.0);
+                add_outer(&mut k, q * coefficients.lift_slope, &lift);
+                add_outer(&mut k, q * coefficients.drag_slope, &drag);
+                out.add_to_group(name, n.delay_lift, &k);
+            } else {
+                for (slope, rows, delay) in [
+                    (coefficients.lift_slope, &lift, n.delay_lift),
+                    (coefficients.drag_slope, &drag, n.delay_drag),
+                ] {
+                    if slope != 0.0 {
+                        k.fill(0.0);
+                        add_outer(&mut k, q * slope, rows);
+                        out.add_to_group(name, delay, &k);
+                    }
+                }
             }
         }
         out.damping.push(ModalMatrix::Dense(damping));
         out
+    }
+
+    /// Adds the dense stiffness `k` to the delay group of delay `delay` (a new group named
+    /// `name` when none has it).
+    fn add_to_group(&mut self, name: &str, delay: f64, k: &[f64]) {
+        match self.delayed.iter_mut().find(|g| g.delay == delay) {
+            Some(DelayedStiffness {
+                stiffness: ModalMatrix::Dense(h),
+                ..
+            }) => h.iter_mut().zip(k).for_each(|(h, k)| *h += k),
+            _ => self.delayed.push(DelayedStiffness {
+                name: name.to_string(),
+                delay,
+                stiffness: ModalMatrix::Dense(k.to_vec()),
+            }),
+        }
     }
 
     /// Tabulated modal coefficients (the form of Code_Aster and EDF; THEORY §13): per mode
@@ -311,8 +334,11 @@ pub struct QuasiSteady {
     pub drag_slope: f64,
     /// Steady drag coefficient `C_D`.
     pub drag: f64,
-    /// Time-lag factor `μ` of `τ = μ D / U`.
-    pub mu: f64,
+    /// Time-lag factor `μ_L` of the lift's delay `τ_L = μ_L D / U`.
+    pub mu_lift: f64,
+    /// Time-lag factor `μ_D` of the drag's delay `τ_D = μ_D D / U` (a streamwise motion's
+    /// delay need not be the transverse one's).
+    pub mu_drag: f64,
 }
 
 /// Modal fluid damping and stiffness per unit length against the reduced velocity, linearly
@@ -358,9 +384,11 @@ pub struct FlowNode<'a> {
     pub density: f64,
     /// Flow velocity `U` (the gap velocity), m/s.
     pub velocity: f64,
-    /// Delay `τ` of the quasi-steady model, s (`μ D / U` with the node's `U`, or with its
-    /// stretch's mean velocity; ignored by the tabulated model).
-    pub delay: f64,
+    /// Delay `τ_L` of the quasi-steady model's lift term, s (`μ_L D / U` with the node's `U`,
+    /// or with its stretch's velocity; ignored by the tabulated model).
+    pub delay_lift: f64,
+    /// Delay `τ_D` of its drag term, s (`μ_D D / U`).
+    pub delay_drag: f64,
     /// Tube outer diameter `D`, m.
     pub diameter: f64,
     /// Unit direction across the flow (lift).

@@ -10,6 +10,7 @@
 //! correlation of [`spatial_correlation`]. See `docs/LOADS.md`.
 
 pub mod flow;
+pub mod flow_damping;
 pub mod fluid_elastic;
 pub mod spatial_correlation;
 pub mod stepped;
