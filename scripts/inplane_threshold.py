@@ -183,7 +183,7 @@ def study(args):
     res = verdicts(os.path.join(args.folder, "study.csv"))
     gap_key = "structures.*.contacts.*.obstacle.gap"
     u_key = "structures.*.flow.zones.0.velocity"
-    pts = sorted(((float(r[u_key]), -float(r[gap_key]) * k, unstable, imp, amp, wn, wf)
+    pts = sorted(((float(r[u_key]), -float(r[gap_key]) * k + 0.0, unstable, imp, amp, wn, wf)
                   for (unstable, imp, amp, wn, wf, r) in res))
     print("| U (m/s) | F (N) | verdict | in-plane impacts/s | apex in-plane max (mm) "
           "| t2t normal wear work rate (W) | t2t friction wear work rate (W) |")
@@ -191,6 +191,24 @@ def study(args):
     for u, f, unstable, imp, amp, wn, wf in pts:
         print(f"| {u:g} | {f:.3g} | {'unstable' if unstable else 'stable'} | {imp:.4g} "
               f"| {amp * 1e3:.3g} | {wn:.3g} | {wf:.3g} |")
+    if args.wear_coefficient:
+        # the worst tube's volume per fuel cycle: every t2t contact wears both rows it joins
+        # (THEORY §15), each by K × the normal wear work rate (Code_Aster's wear power).
+        seconds = args.cycle_years * 365.25 * 86400.0
+        print(f"\nWorst tube's tube-to-tube wear volume per fuel cycle ({args.cycle_years:g} years"
+              f" = {seconds:.4g} s), K = {args.wear_coefficient:g} Pa^-1 on the normal work:")
+        print("| U (m/s) | F (N) | worst row | normal wear work rate on it (W) | volume per cycle (cm³) |")
+        print("|---|---|---|---|---|")
+        for (unstable, imp, amp, wn, wf, r) in sorted(res, key=lambda x: (float(x[5][u_key]), -float(x[5][gap_key]))):
+            per_row = {}
+            for c in columns(list(r), ("t2t_",), "normal_wear_work_rate"):
+                a, b = c.split("_")[1][0], c.split("_")[1][1]  # t2t_<a><b>_<angle>
+                for row in (a, b):
+                    per_row[row] = per_row.get(row, 0.0) + float(r[c])
+            row, w = max(per_row.items(), key=lambda x: x[1])
+            if w > 0.0:
+                v = args.wear_coefficient * w * seconds * 1e6
+                print(f"| {float(r[u_key]):g} | {-float(r[gap_key]) * k + 0.0:.3g} | row{row} | {w:.3g} | {v:.3g} |")
     if args.figure:
         import matplotlib
         matplotlib.use("Agg")
@@ -236,6 +254,9 @@ def main():
     s = sub.add_parser("study", help="table and figure of study_avb_preload's study.csv")
     s.add_argument("folder")
     s.add_argument("--figure", default=None, help="PNG to write (matplotlib)")
+    s.add_argument("--wear-coefficient", type=float, default=None,
+                   help="K, Pa^-1, on the normal work: print the worst tube's volume per cycle")
+    s.add_argument("--cycle-years", type=float, default=1.5)
     args = p.parse_args()
     bisect(args) if args.command == "bisect" else study(args)
 
