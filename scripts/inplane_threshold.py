@@ -113,8 +113,8 @@ def bisect(args):
     hi = {p: args.high for p in pairs}
     log = []
 
-    def step(name, force):
-        runs = [(m, s, force[(m, s)], k) for (m, s) in pairs]
+    def step(name, force, which):
+        runs = [(m, s, force[(m, s)], k) for (m, s) in which]
         res = sweep(args.fretdyn, runs, args.velocity, rows, turbulence,
                     os.path.join(args.output, name))
         for (m, s, f, _), (unstable, imp, amp, wn, wf, _) in zip(runs, res):
@@ -127,8 +127,8 @@ def bisect(args):
         return {(m, s): r[0] for (m, s, _, _), r in zip(runs, res)}
 
     censored = {}
-    at_lo = step("low", lo)
-    at_hi = step("high", hi)
+    at_lo = step("low", lo, pairs)
+    at_hi = step("high", hi, pairs)
     for p in pairs:
         if not at_lo[p]:
             censored[p] = "below"  # stable already at F_lo
@@ -139,7 +139,7 @@ def bisect(args):
         if not active:
             break
         mid = {p: math.sqrt(lo[p] * hi[p]) for p in pairs}
-        v = step(f"step{n + 1}", mid)
+        v = step(f"step{n + 1}", mid, active)  # a censored pair's bracket is not bisected
         for p in active:
             if v[p]:
                 lo[p] = mid[p]
