@@ -166,16 +166,39 @@ def bisect(args):
         w = csv.DictWriter(f, fieldnames=list(log[0]))
         w.writeheader()
         w.writerows(log)
-    print(f"\nU = {args.velocity} m/s, k_N = {k:g} N/m; F* per side (N), bracket per seed:")
-    print("| method | F* mean ± SE (N) | seeds | per seed [F_lo, F_hi] |")
+    print_table([result])
+
+
+def print_table(results):
+    """The thresholds of one or several bisections (same velocity and k_N; other seeds), pooled
+    per method: mean ± standard error over the bracketed seeds."""
+    first = results[0]
+    if any((r["velocity"], r["avb_stiffness"]) != (first["velocity"], first["avb_stiffness"])
+           for r in results):
+        sys.exit("the bisections differ in velocity or k_N: not pooled")
+    print(f"\nU = {first['velocity']} m/s, k_N = {first['avb_stiffness']:g} N/m; "
+          "F* per side (N), bracket per seed:")
+    print("| method | F* mean ± SE (N) | seeds bracketed | per seed [F_lo, F_hi] |")
     print("|---|---|---|---|")
-    for m, r in result["methods"].items():
+    for m in first["methods"]:
+        seeds = [x for r in results for x in r["methods"][m]["seeds"]]
+        f = [x["threshold"] for x in seeds if x["threshold"] is not None]
+        mean = f"{statistics.fmean(f):.3g}" if f else "–"
+        se = f" ± {statistics.stdev(f) / math.sqrt(len(f)):.2g}" if len(f) > 1 else ""
         cells = ", ".join(
-            f"{x['seed']}: [{x['low']:.3g}, {x['high']:.3g}]" + (f" ({x['censored']})" if x["censored"] else "")
-            for x in r["seeds"])
-        ms = "–" if r["mean"] is None else f"{r['mean']:.3g}" + (
-            "" if r["standard_error"] is None else f" ± {r['standard_error']:.2g}")
-        print(f"| {m} | {ms} | {r['n']} | {cells} |")
+            f"{x['seed']}: " + (f"stable at {x['low']:g} N" if x["censored"] == "below" else
+                                f"unstable at {x['high']:g} N" if x["censored"] == "above" else
+                                f"[{x['low']:.3g}, {x['high']:.3g}]")
+            for x in seeds)
+        print(f"| {m} | {mean}{se} | {len(f)} of {len(seeds)} | {cells} |")
+
+
+def table(args):
+    results = []
+    for d in args.folders:
+        with open(os.path.join(d, "thresholds.json")) as f:
+            results.append(json.load(f))
+    print_table(results)
 
 
 def study(args):
@@ -258,8 +281,10 @@ def main():
     s.add_argument("--wear-coefficient", type=float, default=None,
                    help="K, Pa^-1, on the normal work: print the worst tube's volume per cycle")
     s.add_argument("--cycle-years", type=float, default=1.5)
+    t = sub.add_parser("table", help="the thresholds of bisect folders, pooled over their seeds")
+    t.add_argument("folders", nargs="+")
     args = p.parse_args()
-    bisect(args) if args.command == "bisect" else study(args)
+    {"bisect": bisect, "study": study, "table": table}[args.command](args)
 
 
 if __name__ == "__main__":
