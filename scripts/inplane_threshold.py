@@ -11,10 +11,10 @@ tube-to-tube contacts (t2t_*, and row1_inner_* / row3_outer_* against the rigid 
 least one impact. A run whose AVB contacts hold moves its apexes by at most 0.25 mm in the
 plane near the threshold (micrometres at 10 N), against a gap of 8.38 mm between rows; a run
 whose AVBs let go grows to impacts within about a second and swings 20–34 mm (the in-plane
-amplitude, from the apex monitors, is printed beside the verdict so that the two populations
+amplitude, from the apex monitors (`[[output.monitors]]`), is printed beside the verdict so that the two populations
 can be checked apart).
 
-Bisection: for each (method, seed) the force F = k_N δ per side (δ the interference, gap = −δ)
+Bisection: for each (method, seed) the force F = k_N δ per side (δ the interference, `preload.interference`)
 is bisected geometrically, F = √(F_lo F_hi), between F_lo (unstable) and F_hi (stable); every
 step runs all (method, seed) pairs in one `fretdyn sweep` (combine = "list", one core). A seed
 fixes the turbulence of every row (seed, seed + 1000, seed + 2000, as `fretdyn sweep`'s seeds
@@ -37,7 +37,6 @@ import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CASE = os.path.join(ROOT, "examples", "ubend_column_avb.toml")
-MONITOR_STIFFNESS = 100.0  # N/m, the apex monitors' (examples/ubend_column_avb.toml)
 
 
 def avb_stiffness(case):
@@ -71,8 +70,9 @@ def verdicts(table):
         header = list(r)
         imp = sum(float(r[c]) for c in columns(header, TOUCH, "impacts_per_second"))
         amp = max(
-            float(r[c]) / MONITOR_STIFFNESS
-            for c in columns(header, ("inplane_",), "normal_force_max")
+            float(r[c])
+            for c in columns(header, ("row",), "displacement_amplitude")
+            if "_in_plane." in c
         )
         wn = sum(float(r[c]) for c in columns(header, ("t2t_",), "normal_wear_work_rate"))
         wf = sum(float(r[c]) for c in columns(header, ("t2t_",), "wear_work_rate"))
@@ -89,7 +89,7 @@ def sweep(fretdyn, runs, velocity, rows, turbulence, folder):
     def param(key, values):
         lines.extend(["[[parameters]]", f'key = "{key}"', f"values = {json.dumps(values)}", ""])
 
-    param("structures.*.contacts.*.obstacle.gap", [-f / k for (_, _, f, k) in runs])
+    param("structures.*.contacts.*.preload.interference", [f / k for (_, _, f, k) in runs])
     param("tangential.method", [m for (m, _, _, _) in runs])
     param("structures.*.flow.zones.0.velocity", [velocity] * len(runs))
     for i in range(rows):
@@ -205,9 +205,9 @@ def study(args):
     """Table and figure of examples/study_avb_preload.toml's study.csv."""
     k, _, _ = avb_stiffness(CASE)
     res = verdicts(os.path.join(args.folder, "study.csv"))
-    gap_key = "structures.*.contacts.*.obstacle.gap"
+    delta_key = "structures.*.contacts.*.preload.interference"
     u_key = "structures.*.flow.zones.0.velocity"
-    pts = sorted(((float(r[u_key]), -float(r[gap_key]) * k + 0.0, unstable, imp, amp, wn, wf)
+    pts = sorted(((float(r[u_key]), float(r[delta_key]) * k, unstable, imp, amp, wn, wf)
                   for (unstable, imp, amp, wn, wf, r) in res))
     print("| U (m/s) | F (N) | verdict | in-plane impacts/s | apex in-plane max (mm) "
           "| t2t normal wear work rate (W) | t2t friction wear work rate (W) |")
@@ -223,7 +223,7 @@ def study(args):
               f" = {seconds:.4g} s), K = {args.wear_coefficient:g} Pa^-1 on the normal work:")
         print("| U (m/s) | F (N) | worst row | normal wear work rate on it (W) | volume per cycle (cm³) |")
         print("|---|---|---|---|---|")
-        for (unstable, imp, amp, wn, wf, r) in sorted(res, key=lambda x: (float(x[5][u_key]), -float(x[5][gap_key]))):
+        for (unstable, imp, amp, wn, wf, r) in sorted(res, key=lambda x: (float(x[5][u_key]), float(x[5][delta_key]))):
             per_row = {}
             for c in columns(list(r), ("t2t_",), "normal_wear_work_rate"):
                 a, b = c.split("_")[1][0], c.split("_")[1][1]  # t2t_<a><b>_<angle>
@@ -232,7 +232,7 @@ def study(args):
             row, w = max(per_row.items(), key=lambda x: x[1])
             if w > 0.0:
                 v = args.wear_coefficient * w * seconds * 1e6
-                print(f"| {float(r[u_key]):g} | {-float(r[gap_key]) * k + 0.0:.3g} | row{row} | {w:.3g} | {v:.3g} |")
+                print(f"| {float(r[u_key]):g} | {float(r[delta_key]) * k:.3g} | row{row} | {w:.3g} | {v:.3g} |")
     if args.figure:
         import matplotlib
         matplotlib.use("Agg")

@@ -1,4 +1,4 @@
-//! Support-active modes (`[stability]` conditions, THEORY §16, docs/FLOW.md) against closed
+//! Support-active modes (`[stability]` conditions, THEORY §16.3, docs/FLOW.md) against closed
 //! forms and symmetry:
 //! - a straight Euler–Bernoulli tube pinned at its ends (its own supports) and at inner points
 //!   held by a `pinned` condition is the continuous beam on pinned supports: with equal spans

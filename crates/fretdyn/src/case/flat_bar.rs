@@ -1,6 +1,6 @@
 //! `width`, `points_across`, `twist_deg` of a `[[contacts]]` entry on a `plane` or `bi_plane`:
 //! the contact of a flat bar of finite width, possibly twisted, expanded into its points across
-//! the width (`contact::flat_bar`, THEORY §16 draft). Every other key of the entry applies to
+//! the width (`contact::flat_bar`, THEORY §16.2). Every other key of the entry applies to
 //! each point; a wear scar becomes one strip of the bar per point.
 
 use nalgebra::Vector3;

@@ -188,7 +188,7 @@ impl Case {
     }
 
     /// [`Case::stability`] followed by the check of the modes of every support condition of
-    /// `[stability]` (THEORY §16; [`crate::structure::constrained`]), each condition's modes
+    /// `[stability]` (THEORY §16.3; [`crate::structure::constrained`]), each condition's modes
     /// numbered from 1: what `fretdyn stability` reports. `None` without `[flow]`; an error
     /// when a condition's modes cannot be computed.
     pub fn stability_checks(&self) -> Option<Result<StabilityReport>> {

@@ -11,9 +11,9 @@ use crate::contact::tangential::{
 };
 use crate::error::{Error, Result, number};
 use crate::integrator::simulation::RunSettings;
-use crate::settings::Monitor;
 use crate::integrator::stability::checked_stable_time_step;
 use crate::model::Model;
+use crate::settings::Monitor;
 
 use super::shared::point_index;
 

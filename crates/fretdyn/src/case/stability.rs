@@ -3,7 +3,7 @@
 //! supports held at named points or contacts' points, in both directions normal to the tube's
 //! axis (`pinned`), or only normal to the structure's plane (`out_of_plane`) or only in it
 //! (`in_plane`) — and the structure's plane that classes the modes (docs/FLOW.md, "Connors
-//! check"; THEORY §16). Only a tube's finite-element model can hold supports.
+//! check"; THEORY §16.3). Only a tube's finite-element model can hold supports.
 
 use nalgebra::Vector3;
 use serde::Deserialize;

@@ -1,5 +1,5 @@
-//! A flat bar of finite width crossing a tube, its face possibly twisted (THEORY §16, draft in
-//! the issue [3.5]): the contact is a segment along the tube's axis, discretised by `N` point
+//! A flat bar of finite width crossing a tube, its face possibly twisted (THEORY §16.2): the
+//! contact is a segment along the tube's axis, discretised by `N` point
 //! contacts across the width.
 //!
 //! **Geometry.** The tube's axis at the contact is `t`, the bar's (untwisted) outward normal

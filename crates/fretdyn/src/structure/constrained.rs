@@ -1,6 +1,6 @@
 //! Support-active modes of a tube: the modes of its finite-element model with chosen supports
 //! held in chosen directions, for the design-guide stability checks (docs/FLOW.md, "Connors
-//! check with the supports active"; THEORY §16).
+//! check with the supports active"; THEORY §16.3).
 //!
 //! A support held in the unit direction `e` at a named point (node `a`, offset `r` from the
 //! axis) is the linear constraint

@@ -447,7 +447,9 @@ impl Study {
             .iter()
             .map(|m| {
                 let name = m.get("name").or_else(|| m.get("point"));
-                name.and_then(|n| n.as_str()).unwrap_or_default().to_string()
+                name.and_then(|n| n.as_str())
+                    .unwrap_or_default()
+                    .to_string()
             })
             .collect()
     }

@@ -97,7 +97,9 @@ pub(super) fn row(
     }
     cols.extend(life.into_iter().flatten());
     for m in &r.monitors {
-        let cells = m.cells().map(|x| x.map(|x| x.to_string()).unwrap_or_default());
+        let cells = m
+            .cells()
+            .map(|x| x.map(|x| x.to_string()).unwrap_or_default());
         cols.extend(cells);
     }
     cols.push(connors.map(|x| x.to_string()).unwrap_or_default());
